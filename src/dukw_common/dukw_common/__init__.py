@@ -1,0 +1,1 @@
+"""Shared pieces of the DUKW-Ling stack: configuration loading (ROS-free) and thin rclpy helpers."""

@@ -1,0 +1,144 @@
+"""Thin rclpy helpers every DUKW-Ling node uses: QoS by intent, parameters, main loop.
+
+This is the only module of dukw_common that imports rclpy.
+"""
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+from dataclasses import dataclass
+from typing import Callable, Sequence
+
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy,
+                       qos_profile_sensor_data)
+from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+from rclpy.signals import SignalHandlerOptions
+
+from dukw_common.config import ConfigError, ParamValue, node_params
+
+#: Sensor streams: best effort, keep last 5 (rclpy's sensor-data profile).
+SENSOR_QOS = qos_profile_sensor_data
+#: Commands and status that must not be dropped.
+COMMAND_QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
+                         durability=DurabilityPolicy.VOLATILE, history=HistoryPolicy.KEEP_LAST)
+#: Latched state (authority, drive_mode): a late subscriber gets the current value at once.
+STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                       durability=DurabilityPolicy.TRANSIENT_LOCAL,
+                       history=HistoryPolicy.KEEP_LAST)
+
+
+@dataclass(frozen=True)
+class ParamSpec:
+    """A parameter a node declares: its name, meaning and allowed range.
+
+    The default value comes from the stack's parameter file (config/dukw.yaml),
+    never from code; ``--params-file`` and ``-p`` override it as usual.
+    """
+
+    name: str
+    description: str
+    min: float | None = None
+    max: float | None = None
+    read_only: bool = False
+
+
+def declare_parameters(node: Node, specs: Sequence[ParamSpec],
+                       config_path: str | None = None) -> dict[str, ParamValue]:
+    """Declare ``specs`` on ``node`` with defaults from the parameter file; return the values.
+
+    Raises ConfigError naming the parameter when the file lacks a default or a
+    value is out of its range.
+    """
+    defaults = node_params(node.get_name(), config_path)
+    values: dict[str, ParamValue] = {}
+    for spec in specs:
+        if spec.name not in defaults:
+            raise ConfigError(f'{node.get_name()}: parameter {spec.name!r} has no default in '
+                              'the parameter file (config/dukw.yaml)')
+        default = defaults[spec.name]
+        descriptor = ParameterDescriptor(description=spec.description, read_only=spec.read_only)
+        if spec.min is not None or spec.max is not None:
+            lo = spec.min if spec.min is not None else -sys.float_info.max
+            hi = spec.max if spec.max is not None else sys.float_info.max
+            if isinstance(default, int) and not isinstance(default, bool):
+                descriptor.integer_range = [IntegerRange(from_value=int(lo), to_value=int(hi))]
+            else:
+                descriptor.floating_point_range = [
+                    FloatingPointRange(from_value=float(lo), to_value=float(hi))]
+        try:
+            value = node.declare_parameter(spec.name, default, descriptor).value
+        except Exception as exc:  # InvalidParameterValueException & co. from an override
+            raise ConfigError(f'{node.get_name()}: parameter {spec.name!r}: {exc}') from exc
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            if (spec.min is not None and value < spec.min) or (
+                    spec.max is not None and value > spec.max):
+                raise ConfigError(f'{node.get_name()}: parameter {spec.name!r} = {value} is '
+                                  f'outside [{spec.min}, {spec.max}]')
+        values[spec.name] = value
+    return values
+
+
+def param_value(node: Node, name: str) -> ParamValue:
+    """Return a declared parameter's current value."""
+    return node.get_parameter(name).value
+
+
+def parameter_overrides(overrides: dict[str, ParamValue]) -> list[Parameter]:
+    """Turn a dict into rclpy Parameters (for tests constructing nodes directly)."""
+    return [Parameter(k, value=v) for k, v in overrides.items()]
+
+
+def run_node(factory: Callable[[], Node], args: list[str] | None = None) -> int:
+    """Run one node until SIGINT/SIGTERM, then let it stop safely and exit 0.
+
+    The node may define ``on_shutdown()``: it runs while the context is still up,
+    so it can publish a last neutral command. A ConfigError at construction
+    prints a clear message and exits 2.
+    """
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    stop = threading.Event()
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, lambda *_: stop.set())
+    node = None
+    code = 0
+    try:
+        node = factory()
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        while not stop.is_set() and rclpy.ok():
+            executor.spin_once(timeout_sec=0.05)
+    except ConfigError as exc:
+        print(f'[FATAL] {exc}', file=sys.stderr)
+        code = 2
+    finally:
+        if node is not None:
+            shutdown_hook = getattr(node, 'on_shutdown', None)
+            if callable(shutdown_hook) and rclpy.ok():
+                shutdown_hook()
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return code
+
+
+def vehicle_specs(*groups: str) -> list[ParamSpec]:
+    """ParamSpecs for the shared physical facts (``vehicle``, ``drivetrain``, ``soil``...).
+
+    Every value is a non-negative physical quantity except the port bias, which
+    may correct either way. Sources are in config/dukw.yaml and vehicle.md.
+    """
+    from dukw_common import vehicle as v
+    classes = {'vehicle': v.VehicleParams, 'drivetrain': v.DrivetrainParams,
+               'soil': v.SoilParams, 'limits': v.LimitParams, 'site': v.SiteParams}
+    specs = []
+    for group in groups or tuple(classes):
+        for name in classes[group].__dataclass_fields__:
+            lo = -100.0 if name == 'port_bias_pct' else 0.0
+            hi = 100.0 if name.endswith('_pct') else None
+            specs.append(ParamSpec(f'{group}.{name}', f'{group} {name} (see vehicle.md)',
+                                   min=lo, max=hi))
+    return specs

@@ -1,0 +1,155 @@
+"""The vehicle's physical facts as typed settings, built from the shared parameter block.
+
+Values live in config/dukw.yaml (block ``/**``); see shared docs vehicle.md for sources.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Mapping
+
+from dukw_common.config import ConfigError, ParamValue, require, section
+
+
+@dataclass(frozen=True)
+class VehicleParams:
+    """Principal characteristics (vehicle.md section 1)."""
+
+    length_m: float
+    beam_m: float
+    draft_m: float
+    depth_keel_to_deck_m: float
+    waterplane_area_m2: float
+    hull_separation_m: float
+    displacement_n: float
+    kg_m: float
+    gm_m: float
+    lcg_from_bow_m: float
+    track_contact_length_m: float
+    track_width_m: float
+    hull_clearance_m: float
+    hull_radius_m: float
+    hull_length_m: float
+    gravity_mps2: float
+    water_density_kgpm3: float
+
+    @property
+    def mass_kg(self) -> float:
+        """Mass from the displacement (weight), kg."""
+        return self.displacement_n / self.gravity_mps2
+
+    @property
+    def displaced_volume_m3(self) -> float:
+        """Volume of water displaced when afloat, Delta / (rho g), m^3."""
+        return self.displacement_n / (self.water_density_kgpm3 * self.gravity_mps2)
+
+
+@dataclass(frozen=True)
+class DrivetrainParams:
+    """Tracks, propellers and their limits (vehicle.md sections 2-3)."""
+
+    full_scale_track_speed_mps: float
+    track_force_gain_n_per_a: float
+    continuous_current_limit_a: float
+    motor_voltage_v: float
+    no_load_current_a: float
+    sprocket_diameter_m: float
+    gear_reduction: float
+    max_prop_thrust_n: float
+    prop_reverse_thrust_ratio: float
+    port_bias_pct: float
+    max_differential_ratio: float
+
+
+@dataclass(frozen=True)
+class SoilParams:
+    """Modified Wong traction parameters (vehicle.md section 6)."""
+
+    cohesion_pa: float
+    friction_angle_rad: float
+    shear_modulus_m: float
+
+    def __post_init__(self) -> None:
+        if self.cohesion_pa < 0 or self.shear_modulus_m < 0:
+            raise ConfigError('soil cohesion_pa and shear_modulus_m must be >= 0')
+        if not 0.0 <= self.friction_angle_rad < 1.5:
+            raise ConfigError('soil friction_angle_rad must be in [0, 1.5) rad')
+
+
+@dataclass(frozen=True)
+class LimitParams:
+    """Operating limits on inclines (vehicle.md section 3)."""
+
+    incline_sustained_rad: float
+    incline_brief_rad: float
+
+
+@dataclass(frozen=True)
+class SiteParams:
+    """The test site: beach slope and sea floor."""
+
+    beach_slope_rad: float
+    sea_floor_depth_m: float
+
+
+def _build(cls: type, params: Mapping[str, ParamValue], prefix: str):
+    sub = section(params, prefix)
+    names = [f for f in cls.__dataclass_fields__]
+    return cls(**{n: require(sub, n) if n in sub else _missing(prefix, n) for n in names})
+
+
+def _missing(prefix: str, name: str):
+    raise ConfigError(f'missing parameter {prefix}.{name!s}')
+
+
+def vehicle_params(params: Mapping[str, ParamValue]) -> VehicleParams:
+    """Build VehicleParams from dotted parameters (``vehicle.*``)."""
+    return _build(VehicleParams, params, 'vehicle')
+
+
+def drivetrain_params(params: Mapping[str, ParamValue]) -> DrivetrainParams:
+    """Build DrivetrainParams from dotted parameters (``drivetrain.*``)."""
+    return _build(DrivetrainParams, params, 'drivetrain')
+
+
+def limit_params(params: Mapping[str, ParamValue]) -> LimitParams:
+    """Build LimitParams from dotted parameters (``limits.*``)."""
+    return _build(LimitParams, params, 'limits')
+
+
+def site_params(params: Mapping[str, ParamValue]) -> SiteParams:
+    """Build SiteParams from dotted parameters (``site.*``)."""
+    return _build(SiteParams, params, 'site')
+
+
+def soil_params(params: Mapping[str, ParamValue], preset: str | None = None) -> SoilParams:
+    """Build SoilParams: a named preset from ``soil_presets.*``, else the ``soil.*`` values."""
+    if preset:
+        sub = section(params, f'soil_presets.{preset}')
+        if not sub:
+            names = params.get('soil_presets.names', [])
+            raise ConfigError(f'unknown soil preset {preset!r}; known: {names}')
+        return _build(SoilParams, params, f'soil_presets.{preset}')
+    return _build(SoilParams, params, 'soil')
+
+
+@dataclass(frozen=True)
+class Vehicle:
+    """Every shared physical fact in one object, for cores and tools."""
+
+    body: VehicleParams
+    drivetrain: DrivetrainParams
+    soil: SoilParams
+    limits: LimitParams
+    site: SiteParams
+
+    @classmethod
+    def from_params(cls, params: Mapping[str, ParamValue]) -> 'Vehicle':
+        """Build from dotted parameters (a node's declared values or dukw_common.config)."""
+        return cls(vehicle_params(params), drivetrain_params(params), soil_params(params),
+                   limit_params(params), site_params(params))
+
+    @classmethod
+    def load(cls, path: str | None = None) -> 'Vehicle':
+        """Load from the shared block of a parameter file (default: the stack's)."""
+        from dukw_common.config import shared_params
+        return cls.from_params(shared_params(path))

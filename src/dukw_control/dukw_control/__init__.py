@@ -1,0 +1,1 @@
+"""Mode manager and differential-drive controller with the vehicle's limits."""

@@ -1,0 +1,1 @@
+"""EKF node: motion, track slip, hull submersion, traction model."""
