@@ -20,6 +20,7 @@ from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescri
 from rclpy.signals import SignalHandlerOptions
 
 from dukw_common.config import ConfigError, ParamValue, node_params
+from dukw_common.diagnostics import Health
 
 #: Sensor streams: best effort, keep last 5 (rclpy's sensor-data profile).
 SENSOR_QOS = qos_profile_sensor_data
@@ -142,3 +143,29 @@ def vehicle_specs(*groups: str) -> list[ParamSpec]:
             specs.append(ParamSpec(f'{group}.{name}', f'{group} {name} (see vehicle.md)',
                                    min=lo, max=hi))
     return specs
+
+
+def diagnostic_array(node: Node, healths: Sequence[Health]):
+    """Convert core Health values into a stamped diagnostic_msgs/DiagnosticArray."""
+    from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+    array = DiagnosticArray()
+    array.header.stamp = node.get_clock().now().to_msg()
+    for health in healths:
+        status = DiagnosticStatus(level=bytes([int(health.level)]),
+                                  name=f'{node.get_name()}: {health.name}',
+                                  message=health.message, hardware_id=health.hardware_id)
+        status.values = [KeyValue(key=str(k), value=str(v)) for k, v in health.values.items()]
+        array.status.append(status)
+    return array
+
+
+def stamp_to_s(stamp) -> float:
+    """builtin_interfaces/Time -> seconds."""
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
+def s_to_stamp(t_s: float):
+    """Seconds -> builtin_interfaces/Time."""
+    from builtin_interfaces.msg import Time
+    sec = int(t_s // 1)
+    return Time(sec=sec, nanosec=int(round((t_s - sec) * 1e9)) % 1_000_000_000)

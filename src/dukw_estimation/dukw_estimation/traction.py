@@ -1,0 +1,82 @@
+"""Track traction: slip and the modified Wong tractive force (vehicle.md section 6).
+
+One implementation for the simulator, the EKF and the terrain fit. Vectorised:
+every function takes floats or numpy arrays.
+
+    i   = (v_t - v_r) / v_t                       (signed slip)
+    H   = sgn(i) (A c + W_e tan phi) [1 - k/(|i| l) (1 - exp(-|i| l / k))]
+    W_e = (Delta - rho g V) cos(theta)
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from dukw_common.vehicle import SoilParams
+
+ArrayLike = float | np.ndarray
+
+
+def slip(track_speed_mps: ArrayLike, ground_speed_mps: ArrayLike,
+         min_track_speed_mps: float = 0.05) -> ArrayLike:
+    """Signed slip i = (v_t - v_r) / v_t, held sane when the track is nearly stopped.
+
+    Below ``min_track_speed_mps`` the denominator is held at that magnitude (with
+    the track's sign), so a stopped track with a moving vehicle gives a large
+    negative slip instead of infinity; the result is clipped to [-1, 1].
+    """
+    v_t = np.asarray(track_speed_mps, dtype=float)
+    v_r = np.asarray(ground_speed_mps, dtype=float)
+    sign = np.where(v_t >= 0.0, 1.0, -1.0)
+    denom = sign * np.maximum(np.abs(v_t), min_track_speed_mps)
+    i = np.clip((v_t - v_r) / denom, -1.0, 1.0)
+    return float(i) if i.ndim == 0 else i
+
+
+def shear_development(slip_abs: ArrayLike, contact_length_m: float,
+                      shear_modulus_m: float) -> ArrayLike:
+    """The bracket [1 - k/(|i| l) (1 - exp(-|i| l / k))], 0 at no slip, -> 1 at large slip.
+
+    Safe at |i| -> 0 (series 1 - (1 - x/2) = x/2) and at k -> 0 (-> 1).
+    """
+    s = np.abs(np.asarray(slip_abs, dtype=float))
+    if shear_modulus_m <= 0.0:
+        out = np.where(s > 0.0, 1.0, 0.0)
+        return float(out) if out.ndim == 0 else out
+    x = s * contact_length_m / shear_modulus_m
+    small = x < 1e-6
+    x_safe = np.where(small, 1.0, x)
+    out = np.where(small, x / 2.0, 1.0 + np.expm1(-x_safe) / x_safe)
+    return float(out) if out.ndim == 0 else out
+
+
+def max_traction_n(effective_weight_n: ArrayLike, soil: SoilParams,
+                   contact_area_m2: float) -> ArrayLike:
+    """Fully developed shear strength of the contact patch: A c + W_e tan(phi), N."""
+    w = np.maximum(np.asarray(effective_weight_n, dtype=float), 0.0)
+    out = contact_area_m2 * soil.cohesion_pa + w * np.tan(soil.friction_angle_rad)
+    return float(out) if np.ndim(out) == 0 else out
+
+
+def tractive_force_n(slip_: ArrayLike, effective_weight_n: ArrayLike, soil: SoilParams,
+                     contact_area_m2: float, contact_length_m: float) -> ArrayLike:
+    """Modified Wong tractive force H, N, signed like the slip.
+
+    ``contact_area_m2`` and ``effective_weight_n`` are for the tracks the force is
+    wanted for: A = 2 b l and the whole W_e for the vehicle, or b l and W_e / 2
+    for one track. No weight on the tracks (afloat) gives no cohesion either:
+    the patch is off the ground.
+    """
+    i = np.asarray(slip_, dtype=float)
+    w = np.maximum(np.asarray(effective_weight_n, dtype=float), 0.0)
+    strength = np.where(w > 0.0, max_traction_n(w, soil, contact_area_m2), 0.0)
+    out = np.sign(i) * strength * shear_development(i, contact_length_m, soil.shear_modulus_m)
+    return float(out) if out.ndim == 0 else out
+
+
+def effective_weight_n(displacement_n: float, submerged_volume_m3: ArrayLike,
+                       slope_rad: ArrayLike, water_density_kgpm3: float,
+                       gravity_mps2: float) -> ArrayLike:
+    """W_e = (Delta - rho g V) cos(theta), never negative (afloat gives 0), N."""
+    buoyancy = water_density_kgpm3 * gravity_mps2 * np.asarray(submerged_volume_m3, dtype=float)
+    out = np.maximum(displacement_n - buoyancy, 0.0) * np.cos(slope_rad)
+    return float(out) if np.ndim(out) == 0 else out

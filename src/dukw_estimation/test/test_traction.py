@@ -1,0 +1,82 @@
+"""Modified Wong traction model (vehicle.md section 6)."""
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from dukw_common.vehicle import SoilParams
+from dukw_estimation import traction
+
+SOIL = SoilParams(cohesion_pa=150.0, friction_angle_rad=math.radians(9.93), shear_modulus_m=0.053)
+L = 1.07
+A = 2 * 0.0826 * L
+
+
+def wong_reference(i, w, soil, area, length):
+    """Straight transcription of the paper's formula, for i != 0."""
+    k = soil.shear_modulus_m
+    bracket = 1 - k / (abs(i) * length) * (1 - math.exp(-abs(i) * length / k))
+    return math.copysign(1, i) * (area * soil.cohesion_pa + w * math.tan(
+        soil.friction_angle_rad)) * bracket
+
+
+@pytest.mark.parametrize('i', [-0.9, -0.2, -0.01, 0.003, 0.05, 0.3, 1.0])
+def test_matches_the_formula(i):
+    got = traction.tractive_force_n(i, 2000.0, SOIL, A, L)
+    assert got == pytest.approx(wong_reference(i, 2000.0, SOIL, A, L), rel=1e-9)
+
+
+def test_zero_slip_gives_zero_force_and_small_slip_is_smooth():
+    assert traction.tractive_force_n(0.0, 2000.0, SOIL, A, L) == 0.0
+    tiny = traction.tractive_force_n(1e-9, 2000.0, SOIL, A, L)
+    assert 0.0 < tiny < 1e-3
+
+
+def test_sign_follows_slip_and_force_saturates():
+    forces = traction.tractive_force_n(np.linspace(-1, 1, 41), 2000.0, SOIL, A, L)
+    assert np.all(np.diff(forces) >= 0)
+    strength = traction.max_traction_n(2000.0, SOIL, A)
+    assert forces[-1] < strength
+    assert forces[-1] > 0.9 * strength
+    assert forces[0] == pytest.approx(-forces[-1])
+
+
+def test_zero_shear_modulus_is_the_fully_developed_limit():
+    soil = SoilParams(cohesion_pa=180.0, friction_angle_rad=math.radians(5.58), shear_modulus_m=0)
+    assert traction.tractive_force_n(0.2, 1000.0, soil, A, L) == pytest.approx(
+        traction.max_traction_n(1000.0, soil, A))
+
+
+def test_no_weight_no_traction():
+    assert traction.tractive_force_n(0.5, 0.0, SOIL, A, L) == 0.0
+
+
+def test_effective_weight_goes_to_zero_afloat_and_scales_with_cos_slope():
+    assert traction.effective_weight_n(2894.0, 0.0, 0.0, 1025, 9.81) == 2894.0
+    assert traction.effective_weight_n(2894.0, 0.0, math.radians(11), 1025, 9.81) == \
+        pytest.approx(2894.0 * math.cos(math.radians(11)))
+    assert traction.effective_weight_n(2894.0, 0.5, 0.0, 1025, 9.81) == 0.0
+
+
+def test_slip_definition_and_guard_near_standstill():
+    assert traction.slip(2.0, 1.5) == pytest.approx(0.25)
+    assert traction.slip(1.0, 1.2) == pytest.approx(-0.2)  # waves push the vehicle
+    assert traction.slip(0.0, 0.0) == 0.0
+    assert traction.slip(0.0, 0.5) == -1.0
+    assert traction.slip(-1.0, -0.5) == pytest.approx(0.5)
+
+
+@given(st.floats(-1e3, 1e3, allow_nan=False), st.floats(-1e3, 1e3, allow_nan=False))
+def test_slip_is_always_finite_and_bounded(vt, vr):
+    i = traction.slip(vt, vr)
+    assert -1.0 <= i <= 1.0
+
+
+@given(st.floats(-1, 1), st.floats(0, 5000), st.floats(0, 0.3))
+def test_force_never_exceeds_strength(i, w, k):
+    soil = SoilParams(150.0, 0.2, k)
+    force = traction.tractive_force_n(i, w, soil, A, L)
+    assert math.isfinite(force)
+    assert abs(force) <= traction.max_traction_n(w, soil, A) + 1e-9
