@@ -134,11 +134,13 @@ def vehicle_specs(*groups: str) -> list[ParamSpec]:
     """
     from dukw_common import vehicle as v
     classes = {'vehicle': v.VehicleParams, 'drivetrain': v.DrivetrainParams,
-               'soil': v.SoilParams, 'limits': v.LimitParams, 'site': v.SiteParams}
+               'soil': v.SoilParams, 'limits': v.LimitParams, 'site': v.SiteParams,
+               'sensors': v.SensorMounts}
     specs = []
     for group in groups or tuple(classes):
         for name in classes[group].__dataclass_fields__:
-            lo = -100.0 if name == 'port_bias_pct' else 0.0
+            signed = name == 'port_bias_pct' or name.endswith('_x_m')
+            lo = -100.0 if signed else 0.0
             hi = 100.0 if name.endswith('_pct') else None
             specs.append(ParamSpec(f'{group}.{name}', f'{group} {name} (see vehicle.md)',
                                    min=lo, max=hi))

@@ -38,9 +38,34 @@ class VehicleParams:
         return self.displacement_n / self.gravity_mps2
 
     @property
+    def bow_x_m(self) -> float:
+        """Bow in base_link (origin under the LCG), m."""
+        return self.lcg_from_bow_m
+
+    @property
+    def stern_x_m(self) -> float:
+        """Stern in base_link, m."""
+        return self.lcg_from_bow_m - self.length_m
+
+    @property
     def displaced_volume_m3(self) -> float:
         """Volume of water displaced when afloat, Delta / (rho g), m^3."""
         return self.displacement_n / (self.water_density_kgpm3 * self.gravity_mps2)
+
+
+@dataclass(frozen=True)
+class SensorMounts:
+    """Where the sensors sit in base_link, m (config ``sensors.*``)."""
+
+    fore_water_x_m: float
+    fore_water_z_m: float
+    aft_water_x_m: float
+    aft_water_z_m: float
+    depth_sounder_x_m: float
+    depth_sounder_z_m: float
+    depth_sounder_min_m: float
+    imu_z_m: float
+    gps_antenna_z_m: float
 
 
 @dataclass(frozen=True)
@@ -106,6 +131,11 @@ def vehicle_params(params: Mapping[str, ParamValue]) -> VehicleParams:
     return _build(VehicleParams, params, 'vehicle')
 
 
+def sensor_mounts(params: Mapping[str, ParamValue]) -> SensorMounts:
+    """Build SensorMounts from dotted parameters (``sensors.*``)."""
+    return _build(SensorMounts, params, 'sensors')
+
+
 def drivetrain_params(params: Mapping[str, ParamValue]) -> DrivetrainParams:
     """Build DrivetrainParams from dotted parameters (``drivetrain.*``)."""
     return _build(DrivetrainParams, params, 'drivetrain')
@@ -141,12 +171,13 @@ class Vehicle:
     soil: SoilParams
     limits: LimitParams
     site: SiteParams
+    sensors: SensorMounts
 
     @classmethod
     def from_params(cls, params: Mapping[str, ParamValue]) -> 'Vehicle':
         """Build from dotted parameters (a node's declared values or dukw_common.config)."""
         return cls(vehicle_params(params), drivetrain_params(params), soil_params(params),
-                   limit_params(params), site_params(params))
+                   limit_params(params), site_params(params), sensor_mounts(params))
 
     @classmethod
     def load(cls, path: str | None = None) -> 'Vehicle':
