@@ -1,0 +1,1 @@
+"""Bring-up of the whole stack: runner, launch file, mission, bag tools, plots."""
