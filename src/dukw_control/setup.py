@@ -21,6 +21,7 @@ setup(
         'console_scripts': [
             'mode_manager_node = dukw_control.mode_manager_node:main',
             'drive_controller_node = dukw_control.drive_controller_node:main',
+            'maneuver_node = dukw_control.maneuver_node:main',
         ],
     },
 )

@@ -20,6 +20,8 @@ setup(
     entry_points={
         'console_scripts': [
             'ekf_node = dukw_estimation.ekf_node:main',
+            'fit_terrain = dukw_estimation.fit_terrain:main',
+            'evaluate = dukw_estimation.evaluate:main',
         ],
     },
 )

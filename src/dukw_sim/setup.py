@@ -20,6 +20,7 @@ setup(
     entry_points={
         'console_scripts': [
             'sim_node = dukw_sim.sim_node:main',
+            'maneuver = dukw_sim.maneuver:main',
         ],
     },
 )
