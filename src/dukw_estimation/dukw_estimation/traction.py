@@ -39,7 +39,7 @@ def shear_development(slip_abs: ArrayLike, contact_length_m: float,
     Safe at |i| -> 0 (series 1 - (1 - x/2) = x/2) and at k -> 0 (-> 1).
     """
     s = np.abs(np.asarray(slip_abs, dtype=float))
-    if shear_modulus_m <= 0.0:
+    if shear_modulus_m <= 1e-9:  # k -> 0: shear fully developed at any slip
         out = np.where(s > 0.0, 1.0, 0.0)
         return float(out) if out.ndim == 0 else out
     x = s * contact_length_m / shear_modulus_m
