@@ -18,7 +18,7 @@ setup(
     zip_safe=True,
     maintainer='DUKW-Ling team',
     maintainer_email='dev@dukw-ling.invalid',
-    description='Shared parameter loading, vehicle facts and rclpy helpers of the DUKW-Ling stack.',
+    description='Shared parameter loading, vehicle facts and rclpy helpers of the stack.',
     license='Apache-2.0',
     tests_require=['pytest'],
     entry_points={'console_scripts': []},

@@ -14,7 +14,7 @@ setup(
     zip_safe=True,
     maintainer='DUKW-Ling team',
     maintainer_email='dev@dukw-ling.invalid',
-    description='Hardware nodes: servo switch (RC mux), motor controllers, IMU/DGPS, water sensors and depth sounder.',
+    description='Hardware nodes: servo switch, motor controllers, IMU/DGPS, water sensors.',
     license='Apache-2.0',
     tests_require=['pytest'],
     entry_points={

@@ -14,7 +14,7 @@ setup(
     zip_safe=True,
     maintainer='DUKW-Ling team',
     maintainer_email='dev@dukw-ling.invalid',
-    description="Simulator of the DUKW-Ling on sand, in the surf and afloat, behind the drivers' topics.",
+    description='Simulator of the DUKW-Ling on sand, in the surf and afloat.',
     license='Apache-2.0',
     tests_require=['pytest'],
     entry_points={

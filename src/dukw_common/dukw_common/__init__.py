@@ -1,1 +1,1 @@
-"""Shared pieces of the DUKW-Ling stack: configuration loading (ROS-free) and thin rclpy helpers."""
+"""Shared pieces of the DUKW-Ling stack: ROS-free configuration loading, thin rclpy helpers."""

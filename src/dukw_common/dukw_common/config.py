@@ -87,7 +87,7 @@ def shared_params(path: str | os.PathLike | None = None) -> dict[str, ParamValue
 
 
 def require(params: Mapping[str, ParamValue], name: str, kind: type = float) -> Any:
-    """Return ``params[name]`` converted to ``kind``; raise ConfigError naming it if absent or bad."""
+    """Return ``params[name]`` as ``kind``; raise ConfigError naming it if absent or bad."""
     if name not in params:
         raise ConfigError(f'missing parameter {name!r}')
     value = params[name]

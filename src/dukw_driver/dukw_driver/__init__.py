@@ -1,1 +1,1 @@
-"""Hardware nodes: servo switch (RC mux), motor controllers, IMU/DGPS, water sensors and depth sounder."""
+"""Hardware nodes: servo switch (RC mux), motor controllers, IMU/DGPS, water sensors."""

@@ -71,9 +71,9 @@ class Truth:
     ground_height_m: float = 0.0       # sea bed / sand under base_link, odom z
     wave_elevation_m: float = 0.0      # water surface above mean level at base_link
     water_depth_m: float = 0.0         # surface minus ground at base_link (<= 0 on dry sand)
-    fore_sensor_depth_m: float = 0.0   # water surface minus fore water-contact sensor height (> 0: wet)
+    fore_sensor_depth_m: float = 0.0   # surface minus fore water-sensor height (> 0: wet)
     aft_sensor_depth_m: float = 0.0
-    sounder_depth_m: float = 0.0       # water below the depth-sounder transducer (<= 0: out of water)
+    sounder_depth_m: float = 0.0       # water below the sounder transducer (<= 0: dry)
     medium: Medium = Medium.LAND
 
     @classmethod
