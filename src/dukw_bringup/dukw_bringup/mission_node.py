@@ -1,0 +1,117 @@
+"""mission_node: line-of-sight waypoint guidance on ``cmd_vel`` from ``odometry/filtered``.
+
+Subscribes ``odometry/filtered`` (nav_msgs/Odometry); publishes ``cmd_vel``
+(geometry_msgs/Twist, reliable) at ``rate_hz`` and ``mission/status``
+(std_msgs/String, one JSON object of dukw_bringup.mission.Progress, latched)
+on every change of state or waypoint and at ``status_rate_hz``. The mission
+starts ``start_delay_s`` (mission file) after the first odometry; when it is
+done, timed out or the node stops, it sends zero velocity. Time is the node's
+clock, so with ``use_sim_time`` the mission runs on the simulator's /clock.
+"""
+from __future__ import annotations
+
+import math
+
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from rclpy.node import Node
+from std_msgs.msg import String
+
+from dukw_bringup.mission import LosGuidance, MissionState, VelocityCommand, load_mission
+from dukw_common.geometry import euler_from_quaternion
+from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
+                                    declare_parameters, run_node)
+
+
+class MissionNode(Node):
+    """Feeds odometry to LosGuidance and its velocity commands to the controller."""
+
+    def __init__(self) -> None:
+        super().__init__('mission_node')
+        self.params = declare_parameters(self, [
+            ParamSpec('rate_hz', 'guidance and cmd_vel rate, Hz', min=1.0, max=100.0),
+            ParamSpec('status_rate_hz', 'mission/status rate besides on changes, Hz',
+                      min=0.1, max=50.0),
+            ParamSpec('mission_file', "mission YAML; '' = config/mission.yaml"),
+            ParamSpec('odometry_timeout_s', 'stop (zero cmd_vel) while odometry is older, s',
+                      min=0.05, max=10.0),
+        ])
+        self.guidance = LosGuidance(load_mission(str(self.params['mission_file']) or None))
+        self.pose: tuple[float, float, float] | None = None
+        self.pose_time_s = -math.inf
+        self.first_pose_s: float | None = None
+        self.last_key: tuple = ()
+        self.cmd_pub = self.create_publisher(Twist, 'cmd_vel', COMMAND_QOS)
+        self.status_pub = self.create_publisher(String, 'mission/status', STATE_QOS)
+        self.create_subscription(Odometry, 'odometry/filtered', self.on_odometry, SENSOR_QOS)
+        self.create_timer(1.0 / float(self.params['rate_hz']), self.on_tick)
+        self.create_timer(1.0 / float(self.params['status_rate_hz']), self.publish_status)
+        spec = self.guidance.spec
+        self.get_logger().info(f'mission {spec.name!r}: {len(spec.waypoints)} waypoints, '
+                               f'timeout {spec.timeout_s:.0f} s; waiting for odometry')
+
+    def now_s(self) -> float:
+        """The node's clock (sim time under use_sim_time), s."""
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def on_odometry(self, msg: Odometry) -> None:
+        """Keep the latest planar pose; ignore a non-finite one."""
+        q = msg.pose.pose.orientation
+        _, _, yaw = euler_from_quaternion(q.x, q.y, q.z, q.w)
+        pose = (msg.pose.pose.position.x, msg.pose.pose.position.y, yaw)
+        if not all(math.isfinite(v) for v in pose):
+            self.get_logger().warn('non-finite odometry ignored', throttle_duration_sec=5.0)
+            return
+        self.pose, self.pose_time_s = pose, self.now_s()
+        if self.first_pose_s is None:
+            self.first_pose_s = self.pose_time_s
+
+    def on_tick(self) -> None:
+        """Start when due, advance guidance, publish cmd_vel."""
+        now = self.now_s()
+        progress = self.guidance.progress
+        command = VelocityCommand()
+        if self.pose is not None and now - self.pose_time_s <= self.params['odometry_timeout_s']:
+            x, y, yaw = self.pose
+            if (progress.state is MissionState.WAITING and self.first_pose_s is not None
+                    and now - self.first_pose_s >= self.guidance.spec.start_delay_s):
+                self.guidance.start(now, x, y)
+                self.get_logger().info(f'mission started at x={x:.1f} y={y:.1f}')
+            command = self.guidance.update(now, x, y, yaw)
+        elif progress.state is MissionState.RUNNING:
+            self.get_logger().warn('odometry stale: holding zero velocity',
+                                   throttle_duration_sec=2.0)
+        self.publish_command(command)
+        key = (progress.state, progress.waypoint_index)
+        if key != self.last_key:
+            self.last_key = key
+            if progress.state.finished:
+                self.get_logger().info(f'mission {progress.state.value} after '
+                                       f'{progress.elapsed_s:.1f} s')
+            self.publish_status()
+
+    def publish_command(self, command: VelocityCommand) -> None:
+        """Send one cmd_vel."""
+        twist = Twist()
+        twist.linear.x = float(command.speed_mps)
+        twist.angular.z = float(command.yaw_rate_rps)
+        self.cmd_pub.publish(twist)
+
+    def publish_status(self) -> None:
+        """Send the progress as JSON."""
+        self.status_pub.publish(String(data=self.guidance.progress.to_json()))
+
+    def on_shutdown(self) -> None:
+        """Abort (if running) and leave a zero velocity as the last command."""
+        self.guidance.abort()
+        self.publish_command(VelocityCommand())
+        self.publish_status()
+
+
+def main(args=None) -> int:
+    """Console-script entry point."""
+    return run_node(MissionNode, args)
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

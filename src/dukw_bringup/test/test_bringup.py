@@ -1,0 +1,128 @@
+"""The bring-up runner: stack files, starting, a node dying, Ctrl-C, the launch file."""
+import os
+import py_compile
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from dukw_bringup.bringup import load_stack, parse_stack, stack_path
+from dukw_common.config import ConfigError
+
+PACKAGE = Path(__file__).resolve().parents[1]
+SMALL_STACK = """
+stack:
+  name: small
+  nodes:
+    - {name: sim_node, package: dukw_sim, executable: sim_node}
+    - {name: mission_node, package: dukw_bringup, executable: mission_node}
+"""
+
+
+def test_workspace_stacks_parse():
+    sim = load_stack(stack_path('sim'))
+    boat = load_stack(stack_path('boat'))
+    assert [n.name for n in sim.nodes][0] == 'sim_node'
+    assert 'mission_node' in [n.name for n in sim.nodes]
+    assert 'sim_node' not in [n.name for n in boat.nodes]
+    assert {'servo_switch_node', 'imu_gps_node', 'water_sensor_node'} <= {
+        n.executable for n in boat.nodes}
+
+
+@pytest.mark.parametrize('doc,message', [
+    ({}, 'top-level "stack"'),
+    ({'stack': {'nodes': []}}, 'non-empty'),
+    ({'stack': {'nodes': [{'name': 'a', 'package': 'p'}]}}, 'executable'),
+    ({'stack': {'nodes': [{'name': 'a b', 'package': 'p', 'executable': 'e'}]}}, 'name'),
+    ({'stack': {'nodes': [{'name': 'a', 'package': 'p', 'executable': 'e', 'args': 'x'}]}},
+     'args'),
+    ({'stack': {'nodes': [{'name': 'a', 'package': 'p', 'executable': 'e'}] * 2}}, 'unique'),
+])
+def test_bad_stack_file_is_refused(doc, message):
+    with pytest.raises(ConfigError, match=message):
+        parse_stack(doc)
+
+
+def test_launch_file_compiles(tmp_path):
+    py_compile.compile(str(PACKAGE / 'launch' / 'stack.launch.py'),
+                       cfile=str(tmp_path / 'launch.pyc'), doraise=True)
+
+
+class Bringup:
+    """The installed `bringup` console script on a stack file, output collected."""
+
+    def __init__(self, stack_file: Path, *args: str) -> None:
+        from dukw_bringup.bringup import node_executable
+        self.proc = subprocess.Popen(
+            [str(node_executable('dukw_bringup', 'bringup')), str(stack_file), *args],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+    def wait_started(self, count: int, timeout_s: float = 30.0) -> dict[str, int]:
+        """Read output until ``count`` nodes have started; return their pids."""
+        pids: dict[str, int] = {}
+        deadline = time.monotonic() + timeout_s
+        while len(pids) < count and time.monotonic() < deadline:
+            line = self.proc.stdout.readline()
+            match = re.search(r'started (\w+) \(pid (\d+)\)', line)
+            if match:
+                pids[match.group(1)] = int(match.group(2))
+        return pids
+
+    def finish(self, timeout_s: float = 60.0) -> tuple[int, str, str]:
+        out, err = self.proc.communicate(timeout=timeout_s)
+        return self.proc.returncode, out, err
+
+
+def alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    return True
+
+
+@pytest.mark.ros
+@pytest.mark.slow
+def test_a_node_that_dies_stops_the_stack_with_an_error(tmp_path):
+    stack = tmp_path / 'stack.yaml'
+    stack.write_text(SMALL_STACK)
+    runner = Bringup(stack)
+    pids = runner.wait_started(2)
+    assert set(pids) == {'sim_node', 'mission_node'}
+    time.sleep(2.0)
+    os.kill(pids['sim_node'], signal.SIGKILL)
+    code, _, err = runner.finish()
+    assert code == 1
+    assert 'sim_node exited unexpectedly (killed by signal 9)' in err
+    assert not alive(pids['mission_node'])
+
+
+@pytest.mark.ros
+@pytest.mark.slow
+def test_ctrl_c_stops_every_node_in_reverse_order_and_exits_0(tmp_path):
+    stack = tmp_path / 'stack.yaml'
+    stack.write_text(SMALL_STACK)
+    runner = Bringup(stack, '--log-dir', str(tmp_path / 'logs'), '--quiet')
+    pids = runner.wait_started(2)
+    time.sleep(2.0)
+    runner.proc.send_signal(signal.SIGINT)
+    code, out, err = runner.finish()
+    assert code == 0, err
+    assert not any(alive(pid) for pid in pids.values())
+    stopped = re.findall(r'(\w+) stopped \(exit (-?\d+)\)', out)
+    assert stopped == [('mission_node', '0'), ('sim_node', '0')]
+    assert 'waiting for odometry' in (tmp_path / 'logs' / 'mission_node.log').read_text()
+
+
+@pytest.mark.ros
+def test_missing_package_is_a_clear_error(tmp_path):
+    stack = tmp_path / 'stack.yaml'
+    stack.write_text('stack: {nodes: [{name: x, package: no_such_pkg, executable: x}]}\n')
+    result = subprocess.run([sys.executable, '-m', 'dukw_bringup.bringup', str(stack)],
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2
+    assert "package 'no_such_pkg' is not installed" in result.stderr
