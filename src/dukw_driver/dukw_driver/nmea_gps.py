@@ -1,0 +1,131 @@
+"""The differential GPS on NMEA 0183: GGA, RMC, VTG and GST to fixes and velocities. ROS-free.
+
+- GGA gives the fix; its quality field gives the status (2 = DGPS, 4/5 = RTK:
+  a ground-based correction, GBAS_FIX; 9 = WAAS/SBAS; 1 = autonomous; 0, 6
+  (dead reckoning), 7 (manual) and 8 (simulator) = no fix).
+- GST gives the 1-sigma latitude, longitude and altitude errors; a GST younger
+  than ``gst_max_age_s`` makes the fix's covariance DIAGONAL_KNOWN, otherwise it
+  is APPROXIMATED from HDOP times a UERE.
+- VTG (preferred) or RMC (when no VTG came within ``VTG_PREFERRED_S``) gives
+  speed and course over ground -> ENU velocity.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from dukw_driver.gnss import (CovarianceKind, FixStatus, GnssSource, GpsFix, GpsVelocity,
+                              UereSettings, dop_covariance, finite, velocity_from_course)
+from dukw_driver.nmea_stream import NmeaStream
+
+KNOT_MPS = 1852.0 / 3600.0
+#: An RMC velocity is dropped while VTG sentences keep coming within this time.
+VTG_PREFERRED_S = 2.0
+
+GGA_STATUS = {1: FixStatus.FIX, 2: FixStatus.GBAS_FIX, 3: FixStatus.GBAS_FIX,
+              4: FixStatus.GBAS_FIX, 5: FixStatus.GBAS_FIX, 9: FixStatus.SBAS_FIX}
+
+
+@dataclass(frozen=True)
+class NmeaGpsSettings:
+    """How the decoder turns the receiver's figures into covariances."""
+
+    uere: UereSettings
+    speed_std_mps: float      # 1 sigma of speed over ground per axis (not reported by NMEA)
+    gst_max_age_s: float      # a GST older than this no longer describes the fix
+
+
+class GpsNmeaDecoder:
+    """Bytes from the DGPS in, GpsFix and GpsVelocity out; never raises on bad input."""
+
+    SENTENCE_TYPES = ('GGA', 'RMC', 'VTG', 'GST')
+
+    def __init__(self, settings: NmeaGpsSettings) -> None:
+        self.settings = settings
+        self.stream = NmeaStream(self.SENTENCE_TYPES)
+        self.counters = self.stream.counters
+        self._gst: tuple[float, float, float, float] | None = None  # lat, lon, alt std, time
+        self._last_vtg_s = -math.inf
+
+    def reset(self) -> None:
+        """Forget partial input and the last GST (after a reconnect)."""
+        self.stream.reset()
+        self._gst = None
+
+    def feed(self, data: bytes, now_s: float) -> list[GpsFix | GpsVelocity]:
+        """Decode received bytes at time ``now_s``."""
+        out: list[GpsFix | GpsVelocity] = []
+        for sentence in self.stream.feed(data):
+            handler = getattr(self, f'_on_{sentence.sentence_type.lower()}')
+            try:
+                result = handler(sentence, now_s)
+            except (ValueError, TypeError, AttributeError, ArithmeticError):
+                self.counters.parse_errors += 1
+                continue
+            if result is not None:
+                out.append(result)
+        return out
+
+    def _on_gga(self, gga, now_s: float) -> GpsFix:
+        quality = gga.gps_qual
+        status = GGA_STATUS.get(quality if quality is not None else 0, FixStatus.NO_FIX)
+        if status == FixStatus.NO_FIX:
+            nan = math.nan
+            return GpsFix(GnssSource.NMEA, status, nan, nan, nan, (0.0, 0.0, 0.0),
+                          CovarianceKind.UNKNOWN)
+        if not gga.lat or not gga.lon:
+            raise ValueError('fix without a position')
+        latitude, longitude = float(gga.latitude), float(gga.longitude)
+        altitude = float(gga.altitude) + (float(gga.geo_sep) if gga.geo_sep else 0.0)
+        if not finite(latitude, longitude, altitude) or abs(latitude) > 90 or abs(
+                longitude) > 180:
+            raise ValueError('position out of range')
+        covariance, kind = self._covariance(gga, status, now_s)
+        return GpsFix(GnssSource.NMEA, status, latitude, longitude, altitude, covariance, kind)
+
+    def _covariance(self, gga, status: FixStatus, now_s: float) -> tuple:
+        if self._gst is not None and now_s - self._gst[3] <= self.settings.gst_max_age_s:
+            lat_std, lon_std, alt_std, _ = self._gst
+            return (lon_std ** 2, lat_std ** 2, alt_std ** 2), CovarianceKind.DIAGONAL_KNOWN
+        if gga.horizontal_dil:
+            hdop = float(gga.horizontal_dil)
+            if finite(hdop) and hdop > 0:
+                return dop_covariance(hdop, status, self.settings.uere), \
+                    CovarianceKind.APPROXIMATED
+        return (0.0, 0.0, 0.0), CovarianceKind.UNKNOWN
+
+    def _on_gst(self, gst, now_s: float) -> None:
+        stds = (gst.std_dev_latitude, gst.std_dev_longitude, gst.std_dev_altitude)
+        if any(s is None for s in stds) or not finite(*stds) or min(stds) < 0:
+            raise ValueError('GST without usable standard deviations')
+        self._gst = (*(float(s) for s in stds), now_s)
+
+    def _on_vtg(self, vtg, now_s: float) -> GpsVelocity | None:
+        if vtg.spd_over_grnd_kmph is not None:
+            speed = float(vtg.spd_over_grnd_kmph) / 3.6
+        elif vtg.spd_over_grnd_kts is not None:
+            speed = float(vtg.spd_over_grnd_kts) * KNOT_MPS
+        else:
+            return None
+        self._last_vtg_s = now_s
+        return self._velocity(speed, vtg.true_track)
+
+    def _on_rmc(self, rmc, now_s: float) -> GpsVelocity | None:
+        if rmc.status != 'A' or now_s - self._last_vtg_s < VTG_PREFERRED_S:
+            return None
+        if rmc.spd_over_grnd is None:
+            return None
+        return self._velocity(float(rmc.spd_over_grnd) * KNOT_MPS, rmc.true_course)
+
+    def _velocity(self, speed_mps: float, course_deg) -> GpsVelocity | None:
+        if not finite(speed_mps) or speed_mps < 0:
+            raise ValueError('bad speed over ground')
+        if course_deg is None:
+            if speed_mps > 0:
+                return None  # moving with no course: nothing to publish
+            course_deg = 0.0
+        course = float(course_deg)
+        if not finite(course):
+            raise ValueError('bad course over ground')
+        return velocity_from_course(speed_mps, course, self.settings.speed_std_mps ** 2,
+                                    GnssSource.NMEA)
