@@ -1,0 +1,260 @@
+"""replay: feed a bag's messages through the stack's cores without DDS, deterministically.
+
+    replay BAG [--cores mode_manager drive_controller] [--csv OUT_DIR] [--tolerance 1e-6]
+    replay BAG --stream          # raw streaming only: messages per second
+
+Each core sits behind a ``CoreAdapter`` that does what its node does: converts the
+messages it subscribes to into the core's inputs and steps the core on its timer. The
+timer grid is anchored on the first recorded output of that node (so the phase matches
+the recording) and advanced in bag time: a tick at time t sees every input stamped at
+or before t. At each recorded output message the adapter's latest replayed output is
+compared with it, quantity by quantity; ``ReplayResult.deviations`` says which quantity
+moved and by how much. ROS-free: messages are decoded with rosbags (field names as in
+the .msg files).
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import sys
+import time
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Iterable, Sequence
+
+from dukw_bringup.bag_io import BagError, deserialize, read_messages, topic_key, typestore
+
+
+class CoreAdapter(ABC):
+    """One node's core, driven from bag messages like its node would drive it."""
+
+    #: short name, e.g. 'mode_manager'
+    name: str = ''
+    #: topic keys (no leading slash) whose messages the node subscribes to
+    inputs: tuple[str, ...] = ()
+    #: topic key of the output this adapter reproduces and compares
+    output_topic: str = ''
+    #: the node's timer rate, Hz
+    rate_hz: float = 1.0
+
+    @abstractmethod
+    def feed(self, topic: str, t_s: float, msg: Any) -> None:
+        """An input message received at ``t_s`` (bag time, s)."""
+
+    @abstractmethod
+    def tick(self, t_s: float) -> dict[str, float]:
+        """Step the core at ``t_s``; return its output as named numbers."""
+
+    @abstractmethod
+    def recorded(self, msg: Any) -> dict[str, float]:
+        """The same named numbers from a recorded output message."""
+
+
+@dataclass
+class Deviation:
+    """How far one replayed quantity moved from the recording, at its worst."""
+
+    adapter: str
+    quantity: str
+    max_abs: float = 0.0
+    at_s: float = math.nan
+    replayed: float = math.nan
+    recorded: float = math.nan
+    compared: int = 0
+
+    def describe(self) -> str:
+        """One line for a failure message."""
+        return (f'{self.adapter}.{self.quantity}: moved by {self.max_abs:.6g} '
+                f'at t={self.at_s:.3f} s '
+                f'(replayed {self.replayed:.6g}, recorded {self.recorded:.6g}; '
+                f'{self.compared} samples)')
+
+
+@dataclass
+class ReplayResult:
+    """Replayed outputs per adapter and their deviations from the recorded outputs."""
+
+    messages: int = 0
+    elapsed_s: float = 0.0
+    rows: dict[str, list[dict[str, float]]] = field(default_factory=dict)
+    deviations: dict[str, dict[str, Deviation]] = field(default_factory=dict)
+
+    @property
+    def rate_msgs_per_s(self) -> float:
+        """Bag messages processed per wall-clock second."""
+        return self.messages / self.elapsed_s if self.elapsed_s > 0 else math.inf
+
+    def exceeding(self, tolerances: dict[str, float], default: float) -> list[Deviation]:
+        """Deviations above their tolerance (``tolerances`` by quantity or adapter.quantity)."""
+        out = []
+        for adapter, devs in self.deviations.items():
+            for dev in devs.values():
+                tol = tolerances.get(f'{adapter}.{dev.quantity}',
+                                     tolerances.get(dev.quantity, default))
+                if not dev.max_abs <= tol:  # NaN counts as exceeding
+                    out.append(dev)
+        return out
+
+
+class _Driver:
+    """Runs one adapter: timer grid in integer nanoseconds, comparisons at outputs."""
+
+    def __init__(self, adapter: CoreAdapter, first_output_ns: int | None) -> None:
+        if not adapter.rate_hz > 0.0:
+            raise ValueError(f'{adapter.name}: rate_hz must be > 0')
+        self.adapter = adapter
+        self.period_ns = round(1e9 / adapter.rate_hz)
+        self.next_tick_ns = first_output_ns
+        self.latest: dict[str, float] | None = None
+        self.rows: list[dict[str, float]] = []
+        self.deviations: dict[str, Deviation] = {}
+
+    def run_ticks_until(self, t_ns: int, inclusive: bool) -> None:
+        if self.next_tick_ns is None:
+            return
+        while self.next_tick_ns < t_ns or (inclusive and self.next_tick_ns == t_ns):
+            t_s = self.next_tick_ns * 1e-9
+            self.latest = self.adapter.tick(t_s)
+            self.rows.append({'t_s': t_s, **self.latest})
+            self.next_tick_ns += self.period_ns
+
+    def compare(self, t_ns: int, msg: Any) -> None:
+        recorded = self.adapter.recorded(msg)
+        replayed = self.latest or {}
+        for quantity, value in recorded.items():
+            dev = self.deviations.setdefault(quantity, Deviation(self.adapter.name, quantity))
+            mine = replayed.get(quantity, math.nan)
+            diff = 0.0 if math.isnan(mine) and math.isnan(value) else abs(mine - value)
+            dev.compared += 1
+            worse = (dev.compared == 1 or diff > dev.max_abs
+                     or (math.isnan(diff) and not math.isnan(dev.max_abs)))
+            if worse:
+                dev.max_abs, dev.at_s, dev.replayed, dev.recorded = diff, t_ns * 1e-9, mine, value
+
+
+def _first_output_ns(bag: Path, topics: set[str]) -> dict[str, int]:
+    firsts: dict[str, int] = {}
+    for message in read_messages(bag, topics):
+        firsts.setdefault(topic_key(message.topic), message.timestamp_ns)
+        if len(firsts) == len(topics):
+            break
+    return firsts
+
+
+def replay(bag: str | Path, adapters: Sequence[CoreAdapter]) -> ReplayResult:
+    """Feed the bag through ``adapters``; return replayed rows and deviations."""
+    bag = Path(bag)
+    store = typestore()
+    outputs = {a.output_topic for a in adapters}
+    firsts = _first_output_ns(bag, outputs)
+    missing = outputs - set(firsts)
+    if missing:
+        raise BagError(f'{bag}: no recorded {sorted(missing)} to anchor the replay on')
+    drivers = [_Driver(a, firsts[a.output_topic]) for a in adapters]
+    wanted = outputs.union(*(a.inputs for a in adapters))
+    result = ReplayResult()
+    start = time.perf_counter()
+    for message in read_messages(bag, wanted):
+        key = topic_key(message.topic)
+        t_ns = message.timestamp_ns
+        msg = deserialize(message, store)
+        result.messages += 1
+        for driver in drivers:
+            driver.run_ticks_until(t_ns, inclusive=False)
+            if key in driver.adapter.inputs:
+                driver.adapter.feed(key, t_ns * 1e-9, msg)
+            if key == driver.adapter.output_topic:
+                driver.run_ticks_until(t_ns, inclusive=True)
+                driver.compare(t_ns, msg)
+    result.elapsed_s = time.perf_counter() - start
+    for driver in drivers:
+        result.rows[driver.adapter.name] = driver.rows
+        result.deviations[driver.adapter.name] = driver.deviations
+    return result
+
+
+def stream(bag: str | Path, decode: bool = False,
+           topics: Iterable[str] | None = None) -> tuple[int, float]:
+    """Read every message (and decode it if asked); return (count, seconds)."""
+    store = typestore()
+    count = 0
+    start = time.perf_counter()
+    for message in read_messages(bag, topics):
+        if decode:
+            deserialize(message, store)
+        count += 1
+    return count, time.perf_counter() - start
+
+
+def available_adapters() -> dict[str, Callable[[], CoreAdapter]]:
+    """Adapter factories by name, for every core that is importable."""
+    from dukw_bringup import replay_adapters
+    return replay_adapters.factories()
+
+
+def write_csv(rows: list[dict[str, float]], path: Path) -> None:
+    """Write replayed rows (one per tick) to a CSV file."""
+    if not rows:
+        path.write_text('')
+        return
+    with path.open('w', newline='') as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+def parse_args(argv: Sequence[str]) -> argparse.Namespace:
+    """Command-line options."""
+    parser = argparse.ArgumentParser(prog='replay', description=__doc__.split('\n')[0])
+    parser.add_argument('bag', type=Path, help='rosbag2 folder')
+    parser.add_argument('--cores', nargs='+', default=None,
+                        help='adapters to run (default: every available one)')
+    parser.add_argument('--stream', action='store_true',
+                        help='only stream the bag (raw and decoded) and print messages/s')
+    parser.add_argument('--csv', type=Path, default=None,
+                        help='folder for <core>.csv with the replayed outputs')
+    parser.add_argument('--tolerance', type=float, default=1e-6,
+                        help='largest |replayed - recorded| accepted (default 1e-6)')
+    return parser.parse_args(argv)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Console-script entry point: 0 when every replayed output matches the recording."""
+    args = parse_args(sys.argv[1:] if argv is None else argv)
+    try:
+        if args.stream:
+            for decode in (False, True):
+                count, seconds = stream(args.bag, decode)
+                label = 'decoded' if decode else 'raw'
+                print(f'{label:>8}: {count} messages in {seconds:.3f} s = '
+                      f'{count / max(seconds, 1e-9):,.0f} messages/s')
+            return 0
+        factories = available_adapters()
+        names = args.cores or sorted(factories)
+        unknown = set(names) - set(factories)
+        if unknown:
+            print(f'[FATAL] replay: no adapter {sorted(unknown)}; available: '
+                  f'{sorted(factories)}', file=sys.stderr)
+            return 2
+        result = replay(args.bag, [factories[n]() for n in names])
+    except (BagError, ValueError) as exc:
+        print(f'[FATAL] replay: {exc}', file=sys.stderr)
+        return 2
+    print(f'replayed {result.messages} messages in {result.elapsed_s:.3f} s '
+          f'({result.rate_msgs_per_s:,.0f} messages/s)')
+    for name, devs in result.deviations.items():
+        for dev in devs.values():
+            print(f'  {dev.describe()}')
+        if args.csv:
+            args.csv.mkdir(parents=True, exist_ok=True)
+            write_csv(result.rows[name], args.csv / f'{name}.csv')
+    bad = result.exceeding({}, args.tolerance)
+    for dev in bad:
+        print(f'[FAIL] {dev.describe()}', file=sys.stderr)
+    return 1 if bad else 0
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())
