@@ -75,6 +75,9 @@ class Truth:
     aft_sensor_depth_m: float = 0.0
     sounder_depth_m: float = 0.0       # water below the sounder transducer (<= 0: dry)
     medium: Medium = Medium.LAND
+    # appended by the physics core (issue 3)
+    wave_surge_force_n: float = 0.0    # wave (Froude-Krylov + diffraction + drift) force, body x
+    in_ground_contact: bool = True     # tracks touching the sand
 
     @classmethod
     def field_names(cls) -> list[str]:

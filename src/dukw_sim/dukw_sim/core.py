@@ -1,0 +1,514 @@
+"""SimCore: the DUKW-Ling's physics on sand, in the surf and afloat (ROS-free).
+
+State: planar rigid body (x, y, yaw; surge, sway, yaw rate) plus heave, roll and
+pitch of the centre of gravity, the two track drives' speed loops and whether the
+tracks touch the ground. One fixed step of ``dt_s`` (semi-implicit Euler; the stiff
+ground forces are treated implicitly through their derivatives).
+
+Vertical motion: on the ground the vehicle follows the beach (its tracks carry the
+effective weight W_e = (Delta - rho g V) cos theta); when the buoyancy of the hull
+strips against the instantaneous surface exceeds the weight it lifts off and heaves,
+rolls and pitches freely until a track end touches the sand again. So in the surf the
+tracks touch intermittently and the traction comes and goes.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Mapping
+
+import numpy as np
+
+from dukw_common.config import ParamValue, node_params
+from dukw_common.vehicle import SoilParams, Vehicle
+from dukw_estimation import traction
+
+from dukw_sim.hull import HullGeometry, Seakeeping
+from dukw_sim.land import track_step
+from dukw_sim.params import SimParams, apply_overrides
+from dukw_sim.truth import Medium, Truth
+from dukw_sim.world import (Beach, WaveModel, World, irregular_waves, no_waves,
+                            regular_waves)
+
+__all__ = ['Actuation', 'SimCore', 'SimParams']
+
+_ROLL_EPS_MPS = 0.005          # regularisation of Coulomb rolling resistance
+_FRICTION_EPS_MPS = 0.02       # of drivetrain friction
+_BREAKAWAY_MPS = 0.05          # below this track speed the breakaway friction applies
+_LATERAL_POINTS = 5            # points along each track for the lateral resistance
+_LAND_FRACTION = 0.02          # submerged share of the afloat volume below which: LAND
+
+
+@dataclass(frozen=True)
+class Actuation:
+    """What reaches the motor controllers, after the servo switch, % of full scale."""
+
+    port_track_pct: float = 0.0
+    stbd_track_pct: float = 0.0
+    port_prop_pct: float = 0.0
+    stbd_prop_pct: float = 0.0
+
+    def validated(self) -> 'Actuation':
+        """Return self; raise ValueError on a non-finite or out-of-range command."""
+        for name in ('port_track_pct', 'stbd_track_pct', 'port_prop_pct', 'stbd_prop_pct'):
+            value = getattr(self, name)
+            if not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise ValueError(f'actuation {name} must be a finite number, got {value!r}')
+            if abs(value) > 100.0:
+                raise ValueError(f'actuation {name} must be within +-100 %, got {value}')
+        return self
+
+
+def _soil_with_floor(soil: SoilParams, min_k_m: float) -> SoilParams:
+    return SoilParams(soil.cohesion_pa, soil.friction_angle_rad,
+                      max(soil.shear_modulus_m, min_k_m))
+
+
+def _make_world(vehicle: Vehicle, params: SimParams, rng: np.random.Generator) -> World:
+    beach = Beach(vehicle.site.beach_slope_rad, vehicle.site.sea_floor_depth_m,
+                  params.world.flat_start_x_m)
+    w = params.waves
+    if w.model == WaveModel.REGULAR and w.significant_height_m > 0.0:
+        waves = regular_waves(w.significant_height_m, w.peak_period_s, w.reference_depth_m)
+    elif w.model == WaveModel.IRREGULAR and w.significant_height_m > 0.0:
+        waves = irregular_waves(w.significant_height_m, w.peak_period_s, w.reference_depth_m,
+                                rng, w.components, w.jonswap_gamma, w.spreading_rad)
+    else:
+        waves = no_waves()
+    return World(beach, waves, w.breaking_ratio, w.reference_depth_m)
+
+
+class SimCore:
+    """The vehicle in its world, advanced one fixed step at a time."""
+
+    def __init__(self, vehicle: Vehicle, params: SimParams, seed: int = 0) -> None:
+        self.vehicle = vehicle
+        self.params = params
+        self.seed = int(seed)
+        self.dt_s = params.dt_s
+        self.rng = np.random.default_rng(self.seed)
+        self.world = _make_world(vehicle, params, self.rng)
+        self.hull = HullGeometry.from_vehicle(vehicle, params.world.hull_stations)
+        self.seakeeping = Seakeeping.calibrate(self.hull, vehicle, params.seakeeping)
+        body, drive, land = vehicle.body, vehicle.drivetrain, params.land
+        self._mass = body.mass_kg
+        self._weight = body.displacement_n
+        self._rho_g = body.water_density_kgpm3 * body.gravity_mps2
+        self._g = body.gravity_mps2
+        self._afloat_volume = body.displaced_volume_m3
+        self._half_sep = body.hull_separation_m / 2.0
+        self._track_len = body.track_contact_length_m
+        self._track_area = body.track_width_m * body.track_contact_length_m
+        self._kg = body.kg_m
+        self._max_motor_n = drive.track_force_gain_n_per_a * (
+            land.max_current_a - drive.no_load_current_a)
+        self._port_droop_mps = land.port_extra_friction_n / land.speed_loop_stiffness_n_per_mps
+        self._wet_soil = _soil_with_floor(vehicle.soil, land.min_shear_modulus_m)
+        dry = params.dry_soil or vehicle.soil
+        self._dry_soil = _soil_with_floor(dry, land.min_shear_modulus_m)
+        s = vehicle.sensors
+        n = self.hull.station_x_m.size
+        self._n_stations = n
+        # body-frame sample points: hull strips, then base_link, fore, aft sensors, sounder
+        self._pts_x = np.concatenate([self.hull.station_x_m,
+                                      [0.0, s.fore_water_x_m, s.aft_water_x_m,
+                                       s.depth_sounder_x_m]])
+        self._pts_y = np.concatenate([self.hull.station_y_m, [0.0, 0.0, 0.0, 0.0]])
+        self._lat_s = [self._track_len * ((j + 0.5) / _LATERAL_POINTS - 0.5)
+                       for j in range(_LATERAL_POINTS)]
+        self._stern_idx = (int(np.argmin(self.hull.station_x_m[:n // 2])),
+                           n // 2 + int(np.argmin(self.hull.station_x_m[n // 2:])))
+        self._external = (0.0, 0.0, 0.0)
+        self._water_key = None
+        self._water = None
+        self.reset()
+
+    @classmethod
+    def from_config(cls, path=None, overrides: Mapping[str, ParamValue] | None = None,
+                    seed: int = 0) -> 'SimCore':
+        """Build from the parameter file (shared block + sim_node block) and dotted overrides."""
+        params = apply_overrides(node_params('sim_node', path), overrides)
+        return cls(Vehicle.from_params(params), SimParams.from_params(params), seed)
+
+    # ----------------------------------------------------------------- reset / helpers
+    def reset(self, start: str = 'sand', x_m: float | None = None,
+              yaw_rad: float = 0.0) -> Truth:
+        """Put the vehicle at rest at a configured start ('sand', 'surf', 'afloat') or at x_m."""
+        starts = {'sand': self.params.start.sand_x_m, 'surf': self.params.start.surf_x_m,
+                  'afloat': self.params.start.afloat_x_m}
+        if x_m is None:
+            if start not in starts:
+                raise ValueError(f'start must be one of {sorted(starts)}, got {start!r}')
+            x_m = starts[start]
+        if not (math.isfinite(x_m) and math.isfinite(yaw_rad)):
+            raise ValueError('reset position and yaw must be finite')
+        self.t_s = 0.0
+        self.x, self.y, self.yaw = float(x_m), 0.0, float(yaw_rad)
+        self.u = self.v = self.r = 0.0
+        self.heave_vel = self.roll_rate = self.pitch_rate = 0.0
+        self.ref = [0.0, 0.0]
+        self.track_speed = [0.0, 0.0]
+        self._external = (0.0, 0.0, 0.0)
+        gz, gpitch, groll, _ = self._ground_pose()
+        self.z_cg, self.pitch, self.roll = gz + self._kg, gpitch, groll
+        self.in_contact = True
+        if self._grounded_buoyancy() >= self._weight:
+            self.in_contact = False
+            self.z_cg = self._float_height()
+            self.pitch = self.roll = 0.0
+        self.truth = self._compute_truth(Actuation(), None)
+        return self.truth
+
+    def set_external_force(self, fx_n: float = 0.0, fy_n: float = 0.0,
+                           yaw_moment_nm: float = 0.0) -> None:
+        """A horizontal force on the vehicle in odom (a tow line, a hand holding it), N."""
+        for value in (fx_n, fy_n, yaw_moment_nm):
+            if not math.isfinite(value):
+                raise ValueError('external force must be finite')
+        self._external = (float(fx_n), float(fy_n), float(yaw_moment_nm))
+
+    def _ground_pose(self) -> tuple[float, float, float, float]:
+        """Ground height at base_link, pitch and roll of a vehicle resting on it, slope."""
+        beach = self.world.beach
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        half = self._track_len / 2.0
+        front = beach.height_m(self.x + c * half)
+        rear = beach.height_m(self.x - c * half)
+        left = beach.height_m(self.x - s * self._half_sep)
+        right = beach.height_m(self.x + s * self._half_sep)
+        pitch = math.atan2(rear - front, self._track_len)
+        roll = math.atan2(left - right, 2.0 * self._half_sep)
+        grad = beach.gradient(self.x)
+        return 0.5 * (front + rear), pitch, roll, math.atan(abs(grad))
+
+    def _strip_depths(self, eta: np.ndarray, z_cg: float, pitch: float,
+                      roll: float) -> np.ndarray:
+        n = self._n_stations
+        bottom = (z_cg + self.hull.bottom_above_cg_m - self.hull.station_x_m * math.sin(pitch)
+                  + self.hull.station_y_m * math.sin(roll))
+        return eta[:n] - bottom
+
+    def _sample_water(self):
+        key = (self.t_s, self.x, self.y, self.yaw, self.z_cg)
+        if self._water_key == key:
+            return self._water
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        px = self.x + c * self._pts_x - s * self._pts_y
+        py = self.y + s * self._pts_x + c * self._pts_y
+        pz = np.full(px.shape, self.z_cg + self.hull.axis_above_cg_m)
+        self._water_key = key
+        self._water = (px, self.world.sample(px, py, pz, self.t_s))
+        return self._water
+
+    def _grounded_buoyancy(self) -> float:
+        _, water = self._sample_water()
+        depths = self._strip_depths(water.elevation_m, self.z_cg, self.pitch, self.roll)
+        return self._rho_g * float(np.sum(self.hull.areas_m2(depths))) * self.hull.strip_length_m
+
+    def _float_height(self) -> float:
+        """Centre-of-gravity height at which the level hull floats on the current surface."""
+        _, water = self._sample_water()
+        lo, hi = -5.0, 5.0
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            depths = self._strip_depths(water.elevation_m, mid, 0.0, 0.0)
+            b = self._rho_g * float(np.sum(self.hull.areas_m2(depths))) * self.hull.strip_length_m
+            if b > self._weight:
+                lo = mid
+            else:
+                hi = mid
+        return 0.5 * (lo + hi)
+
+    # ----------------------------------------------------------------------- step
+    def step(self, act: Actuation) -> Truth:
+        """Advance one step of dt_s with the commands ``act``; return the new Truth."""
+        if not isinstance(act, Actuation):
+            raise ValueError(f'step needs an Actuation, got {type(act).__name__}')
+        act.validated()
+        dt = self.dt_s
+        p = self.params
+        veh = self.vehicle
+        u0, v0, r0, hv0 = self.u, self.v, self.r, self.heave_vel
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+
+        # --- water at the strips and sample points
+        px, water = self._sample_water()
+        n = self._n_stations
+        gz, gpitch, groll, slope = self._ground_pose()
+        if self.in_contact:
+            self.z_cg, self.pitch, self.roll = gz + self._kg, gpitch, groll
+        depths = self._strip_depths(water.elevation_m, self.z_cg, self.pitch, self.roll)
+        areas = self.hull.areas_m2(depths)
+        strip_f = self._rho_g * self.hull.strip_length_m * areas
+        buoy = float(np.sum(strip_f))
+        volume = buoy / self._rho_g
+        frac = min(volume / self._afloat_volume, 1.0)
+
+        # --- contact: lift off when the water carries the weight
+        if self.in_contact and buoy >= self._weight:
+            self.in_contact = False
+        if self.in_contact:
+            w_eff = traction.effective_weight_n(self._weight, volume, slope,
+                                                veh.body.water_density_kgpm3, self._g)
+        else:
+            w_eff = 0.0
+
+        # --- wave forces on the hull strips (Froude-Krylov + diffraction), odom
+        cm_rho = p.waves.surge_inertia_coeff * veh.body.water_density_kgpm3
+        if self.world.calm:
+            fwx = fwy = 0.0
+            wu = wv = 0.0
+        else:
+            vol_strip = areas * self.hull.strip_length_m
+            fwx = cm_rho * float(vol_strip @ water.accel_x_mps2[:n])
+            fwy = cm_rho * float(vol_strip @ water.accel_y_mps2[:n])
+            drift = (p.waves.drift_force_coeff * 0.5 * self._rho_g
+                     * float(np.sum(self.world.waves.amplitude_m ** 2))
+                     * veh.body.beam_m * frac)
+            fwx -= drift                                    # shoreward, with the waves
+            if volume > 1e-9:
+                wu = float(areas @ water.velocity_x_mps[:n]) / float(np.sum(areas))
+                wv = float(areas @ water.velocity_y_mps[:n]) / float(np.sum(areas))
+            else:
+                wu = wv = 0.0
+        # water velocity in body axes
+        uw = c * wu + s * wv
+        vw = -s * wu + c * wv
+        u_rel, v_rel = u0 - uw, v0 - vw
+
+        # --- track drives
+        land = p.land
+        full = veh.drivetrain.full_scale_track_speed_mps
+        targets = [act.port_track_pct / 100.0 * full, act.stbd_track_pct / 100.0 * full]
+        if targets[0] != 0.0:
+            targets[0] -= math.copysign(min(abs(targets[0]), self._port_droop_mps), targets[0])
+        alpha = min(dt / land.speed_loop_time_constant_s, 1.0)
+        self.ref = [self.ref[i] + (targets[i] - self.ref[i]) * alpha for i in range(2)]
+        ground = (u0 - r0 * self._half_sep, u0 + r0 * self._half_sep)
+        track_imm = min(max(float(np.mean(depths)) / (2.0 * self.hull.radius_m), 0.0), 1.0)
+        others = []
+        paddle = []
+        for i in range(2):
+            fric = land.drivetrain_friction_n + (land.port_extra_friction_n if i == 0 else 0.0)
+            ts = self.track_speed[i]
+            if abs(ts) < _BREAKAWAY_MPS:
+                fric *= 1.0 + (land.breakaway_friction_ratio - 1.0) * (
+                    1.0 - abs(ts) / _BREAKAWAY_MPS)
+            fric *= math.tanh(self.ref[i] / _FRICTION_EPS_MPS)
+            rel = self.ref[i] - u_rel
+            pad = p.water.track_paddle_coeff_n_per_mps2 * rel * abs(rel) * track_imm
+            paddle.append(pad)
+            others.append(fric + pad)
+        soil = self._dry_soil if self.x < p.world.wet_sand_start_x_m else self._wet_soil
+        tracks = track_step(tuple(self.ref), ground, tuple(others), self._max_motor_n,
+                            w_eff / 2.0, soil, self._track_area, self._track_len)
+        self.track_speed = tracks.track_speed_mps
+        fp, fs = tracks.soil_force_n
+
+        # --- forces in body axes (X forward, Y left, N yaw) and their derivatives
+        X = fp + fs + paddle[0] + paddle[1]
+        Y = 0.0
+        N = (fs - fp + paddle[1] - paddle[0]) * self._half_sep
+        j_u = -(tracks.dforce_dground[0] + tracks.dforce_dground[1])
+        j_u = -abs(j_u)
+        j_v = 0.0
+        j_r = -abs(tracks.dforce_dground[0] + tracks.dforce_dground[1]) * self._half_sep ** 2
+        if w_eff > 0.0:
+            roll_n = land.rolling_resistance_coeff * w_eff / 2.0
+            for i, sign in ((0, -1.0), (1, 1.0)):
+                th = math.tanh(ground[i] / _ROLL_EPS_MPS)
+                f = -roll_n * th
+                X += f
+                N += sign * f * self._half_sep
+                dth = roll_n * (1.0 - th * th) / _ROLL_EPS_MPS
+                j_u -= dth
+                j_r -= dth * self._half_sep ** 2
+            lat_n = land.lateral_friction_coeff * w_eff / _LATERAL_POINTS
+            v_ref = land.lateral_slip_speed_mps
+            for s_j in self._lat_s:
+                th = math.tanh((v0 + r0 * s_j) / v_ref)
+                f = -lat_n * th
+                Y += f
+                N += f * s_j
+                d = lat_n * (1.0 - th * th) / v_ref
+                j_v -= d
+                j_r -= d * s_j * s_j
+            # gravity along the slope: (Delta - B) sin(theta), downhill, odom -> body
+            grad = self.world.beach.gradient(self.x)
+            if grad != 0.0:
+                down = -(self._weight - buoy) * grad / math.sqrt(1.0 + grad * grad)
+                X += c * down
+                Y += -s * down
+        # water: propellers, drag, walk
+        wat = p.water
+        stern_imm = [min(max(float(depths[k]) / (2.0 * self.hull.radius_m), 0.0), 1.0)
+                     for k in self._stern_idx]
+        thrust = [self._thrust(act.port_prop_pct) * stern_imm[0],
+                  self._thrust(act.stbd_prop_pct) * stern_imm[1]]
+        X += thrust[0] + thrust[1]
+        N += (thrust[1] - thrust[0]) * self._half_sep
+        walk = -wat.prop_walk_ratio * (thrust[0] + thrust[1])
+        Y += walk
+        N += walk * wat.prop_x_m
+        X -= (wat.surge_linear_drag_n_per_mps * u_rel
+              + wat.surge_quadratic_drag_n_per_mps2 * abs(u_rel) * u_rel) * frac
+        Y -= (wat.sway_linear_drag_n_per_mps * v_rel
+              + wat.sway_quadratic_drag_n_per_mps2 * abs(v_rel) * v_rel) * frac
+        N -= (wat.yaw_linear_drag_nm_per_rps * r0
+              + wat.yaw_quadratic_drag_nm_per_rps2 * abs(r0) * r0) * frac
+        j_u -= (wat.surge_linear_drag_n_per_mps
+                + 2.0 * wat.surge_quadratic_drag_n_per_mps2 * abs(u_rel)) * frac
+        j_v -= (wat.sway_linear_drag_n_per_mps
+                + 2.0 * wat.sway_quadratic_drag_n_per_mps2 * abs(v_rel)) * frac
+        j_r -= (wat.yaw_linear_drag_nm_per_rps
+                + 2.0 * wat.yaw_quadratic_drag_nm_per_rps2 * abs(r0)) * frac
+        # waves and external forces, odom -> body
+        ex, ey, en = self._external
+        X += c * (fwx + ex) + s * (fwy + ey)
+        Y += -s * (fwx + ex) + c * (fwy + ey)
+        N += en
+
+        # --- planar rigid body with added mass (semi-implicit Euler)
+        m_x = self._mass * (1.0 + wat.surge_added_mass_ratio * frac)
+        m_y = self._mass * (1.0 + wat.sway_added_mass_ratio * frac)
+        i_z = wat.yaw_inertia_kg_m2 * (1.0 + wat.yaw_added_inertia_ratio * frac)
+        du = dt * (X + m_y * v0 * r0) / (m_x - dt * j_u)
+        dv = dt * (Y - m_x * u0 * r0) / (m_y - dt * j_v)
+        dr = dt * N / (i_z - dt * j_r)
+        self.u, self.v, self.r = u0 + du, v0 + dv, r0 + dr
+        self.yaw = (self.yaw + dt * self.r + math.pi) % (2.0 * math.pi) - math.pi
+        self.x += dt * (c * self.u - s * self.v)
+        self.y += dt * (s * self.u + c * self.v)
+
+        # --- heave, roll, pitch
+        sk = self.seakeeping
+        if self.in_contact:
+            ngz, npitch, nroll, _ = self._ground_pose()
+            nz = ngz + self._kg
+            self.heave_vel = (nz - self.z_cg) / dt
+            self.roll_rate = (nroll - self.roll) / dt
+            self.pitch_rate = (npitch - self.pitch) / dt
+            self.z_cg, self.pitch, self.roll = nz, npitch, nroll
+        else:
+            m_roll = float(strip_f @ self.hull.station_y_m)
+            m_pitch = -float(strip_f @ self.hull.station_x_m)
+            self.heave_vel += dt * (buoy - self._weight - sk.heave_damping_n_per_mps
+                                    * self.heave_vel * frac) / sk.heave_mass_kg
+            self.roll_rate += dt * (m_roll - sk.roll_damping_nm_per_rps
+                                    * self.roll_rate * frac) / sk.roll_inertia_kg_m2
+            self.pitch_rate += dt * (m_pitch - sk.pitch_damping_nm_per_rps
+                                     * self.pitch_rate * frac) / sk.pitch_inertia_kg_m2
+            self.z_cg += dt * self.heave_vel
+            self.roll += dt * self.roll_rate
+            self.pitch += dt * self.pitch_rate
+            self._touchdown()
+        self.t_s += dt
+        accel = ((self.u - u0) / dt - self.r * self.v, (self.v - v0) / dt + self.r * self.u,
+                 (self.heave_vel - hv0) / dt)
+        self.truth = self._compute_truth(act, (tracks, thrust, w_eff, volume, fwx, fwy, accel))
+        return self.truth
+
+    def _thrust(self, pct: float) -> float:
+        """Propeller thrust for a command, N (reverse weaker, vehicle.md section 1)."""
+        drive = self.vehicle.drivetrain
+        t = drive.max_prop_thrust_n * pct / 100.0
+        return t if pct >= 0.0 else t * drive.prop_reverse_thrust_ratio
+
+    def _touchdown(self) -> None:
+        """Land on the sand when a track end reaches it (an inelastic contact)."""
+        gz, gpitch, groll, _ = self._ground_pose()
+        base = self.z_cg - self._kg
+        half = self._track_len / 2.0
+        lowest = base - half * abs(math.sin(self.pitch - gpitch)) \
+            - self._half_sep * abs(math.sin(self.roll - groll))
+        if lowest <= gz:
+            self.in_contact = True
+            self.z_cg, self.pitch, self.roll = gz + self._kg, gpitch, groll
+            self.heave_vel = self.roll_rate = self.pitch_rate = 0.0
+
+    # ---------------------------------------------------------------------- truth
+    def _compute_truth(self, act: Actuation, stepped) -> Truth:
+        veh = self.vehicle
+        drive = veh.drivetrain
+        sens = veh.sensors
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        px, water = self._sample_water()
+        n = self._n_stations
+        eta = water.elevation_m
+        depths = self._strip_depths(eta, self.z_cg, self.pitch, self.roll)
+        volume = float(np.sum(self.hull.areas_m2(depths))) * self.hull.strip_length_m
+        beach = self.world.beach
+        ground = beach.height_m(self.x)
+        base_z = self.z_cg - self._kg
+        sp, cp = math.sin(self.pitch), math.cos(self.pitch)
+        sr, cr = math.sin(self.roll), math.cos(self.roll)
+
+        def sensor_z(bx: float, bz: float) -> float:
+            return base_z - bx * sp + bz * cp * cr
+
+        sounder_z = sensor_z(sens.depth_sounder_x_m, sens.depth_sounder_z_m)
+        sounder_ground = beach.height_m(float(px[n + 3]))
+        if eta[n + 3] > sounder_z:
+            sounder = sounder_z - sounder_ground
+        else:
+            sounder = float(eta[n + 3]) - sounder_z
+        if stepped is None:
+            tracks = None
+            thrust = [0.0, 0.0]
+            w_eff = traction.effective_weight_n(self._weight, volume, math.atan(abs(
+                beach.gradient(self.x))), veh.body.water_density_kgpm3, self._g) \
+                if self.in_contact else 0.0
+            fwx = fwy = 0.0
+            accel = (0.0, 0.0, 0.0)
+        else:
+            tracks, thrust, w_eff, volume, fwx, fwy, accel = stepped
+        g_up = self._g + accel[2]
+        if tracks is not None:
+            speeds, forces, motor, slips = (tracks.track_speed_mps, tracks.soil_force_n,
+                                            tracks.motor_force_n, tracks.slip)
+        else:
+            speeds, forces, motor, slips = [0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0]
+        gain = drive.track_force_gain_n_per_a
+        currents = [motor[i] / gain + drive.no_load_current_a * math.tanh(speeds[i] / 0.1)
+                    for i in range(2)]
+        prop_i = [self.params.water.prop_max_current_a
+                  * min(abs(thrust[i]) / drive.max_prop_thrust_n, 1.0) ** 1.5 for i in range(2)]
+        battery = drive.motor_voltage_v - self.params.battery_internal_resistance_ohm * (
+            abs(currents[0]) + abs(currents[1]) + prop_i[0] + prop_i[1])
+        if not self.in_contact:
+            medium = Medium.WATER
+        elif volume < _LAND_FRACTION * self._afloat_volume:
+            medium = Medium.LAND
+        else:
+            medium = Medium.TRANSITION
+        slope = math.atan(abs(beach.gradient(self.x)))
+        return Truth(
+            t_s=self.t_s, x_m=self.x, y_m=self.y, z_m=base_z,
+            roll_rad=self.roll, pitch_rad=self.pitch, yaw_rad=self.yaw,
+            surge_mps=self.u, sway_mps=self.v, heave_mps=self.heave_vel,
+            roll_rate_rps=self.roll_rate, pitch_rate_rps=self.pitch_rate,
+            yaw_rate_rps=self.r,
+            accel_x_mps2=accel[0] - g_up * sp,
+            accel_y_mps2=accel[1] + g_up * sr * cp,
+            accel_z_mps2=g_up * cr * cp,
+            port_cmd_pct=act.port_track_pct, stbd_cmd_pct=act.stbd_track_pct,
+            port_track_speed_mps=speeds[0], stbd_track_speed_mps=speeds[1],
+            port_slip=slips[0], stbd_slip=slips[1],
+            port_force_n=forces[0], stbd_force_n=forces[1],
+            port_current_a=currents[0], stbd_current_a=currents[1],
+            port_prop_cmd_pct=act.port_prop_pct, stbd_prop_cmd_pct=act.stbd_prop_pct,
+            port_thrust_n=thrust[0], stbd_thrust_n=thrust[1],
+            port_prop_current_a=prop_i[0], stbd_prop_current_a=prop_i[1],
+            battery_voltage_v=battery,
+            submerged_volume_m3=volume, effective_weight_n=w_eff,
+            weight_on_tracks_fraction=(max(self._weight - self._rho_g * volume, 0.0)
+                                       / self._weight if self.in_contact else 0.0),
+            waterline_distance_m=beach.distance_along_slope_m(self.x),
+            slope_rad=slope, ground_height_m=ground,
+            wave_elevation_m=float(eta[n]), water_depth_m=float(eta[n]) - ground,
+            fore_sensor_depth_m=float(eta[n + 1]) - sensor_z(sens.fore_water_x_m,
+                                                              sens.fore_water_z_m),
+            aft_sensor_depth_m=float(eta[n + 2]) - sensor_z(sens.aft_water_x_m,
+                                                             sens.aft_water_z_m),
+            sounder_depth_m=sounder, medium=medium,
+            wave_surge_force_n=c * fwx + s * fwy, in_ground_contact=self.in_contact)

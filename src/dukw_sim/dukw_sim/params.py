@@ -1,0 +1,195 @@
+"""The simulator's own settings (config ``sim_node`` block), beyond the shared Vehicle.
+
+Every value's source is in config/dukw.yaml; nothing here has a default.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+from typing import Mapping
+
+from dukw_common.config import ConfigError, ParamValue, require, section
+from dukw_common.vehicle import SoilParams, soil_params
+
+from dukw_sim.world import WaveModel
+
+# Override names accepted for the shared site block (the world's beach lives there).
+SITE_ALIASES = {'world.beach_slope_rad': 'site.beach_slope_rad',
+                'world.sea_floor_depth_m': 'site.sea_floor_depth_m'}
+
+
+def _build(cls: type, params: Mapping[str, ParamValue], prefix: str):
+    """Build a frozen settings dataclass from the dotted parameters under ``prefix``."""
+    sub = section(params, prefix)
+    values = {}
+    for f in fields(cls):
+        if f.name not in sub:
+            raise ConfigError(f'missing parameter {prefix}.{f.name}')
+        kind = {'float': float, 'int': int, 'str': str}[f.type]
+        values[f.name] = require(sub, f.name, kind)
+    return cls(**values)
+
+
+def _positive(obj, *names: str) -> None:
+    for name in names:
+        if not getattr(obj, name) > 0.0:
+            raise ConfigError(f'{type(obj).__name__}.{name} must be > 0')
+
+
+@dataclass(frozen=True)
+class WorldParams:
+    """Beach layout beyond the shared site block."""
+
+    flat_start_x_m: float
+    wet_sand_start_x_m: float
+    dry_soil_preset: str
+    hull_stations: int
+
+    def __post_init__(self) -> None:
+        if self.flat_start_x_m >= 0.0:
+            raise ConfigError('world.flat_start_x_m must be < 0 (landward of the waterline)')
+        if not 2 <= self.hull_stations <= 64:
+            raise ConfigError('world.hull_stations must be in [2, 64]')
+
+
+@dataclass(frozen=True)
+class WaveParams:
+    """Wave field: a regular wave (height H) or a JONSWAP sea (Hs), travelling shoreward."""
+
+    model: str
+    significant_height_m: float
+    peak_period_s: float
+    jonswap_gamma: float
+    components: int
+    spreading_rad: float
+    reference_depth_m: float
+    breaking_ratio: float
+    surge_inertia_coeff: float
+    drift_force_coeff: float
+
+    def __post_init__(self) -> None:
+        if self.model not in WaveModel.ALL:
+            raise ConfigError(f'waves.model must be one of {WaveModel.ALL}, got {self.model!r}')
+        if self.significant_height_m < 0.0:
+            raise ConfigError('waves.significant_height_m must be >= 0')
+        _positive(self, 'peak_period_s', 'jonswap_gamma', 'reference_depth_m', 'breaking_ratio')
+        if self.components < 1:
+            raise ConfigError('waves.components must be >= 1')
+
+
+@dataclass(frozen=True)
+class LandParams:
+    """Track drives and the ground (vehicle.md sections 2, 3, 6)."""
+
+    max_current_a: float
+    speed_loop_time_constant_s: float
+    speed_loop_stiffness_n_per_mps: float
+    drivetrain_friction_n: float
+    port_extra_friction_n: float
+    breakaway_friction_ratio: float
+    rolling_resistance_coeff: float
+    lateral_friction_coeff: float
+    lateral_slip_speed_mps: float
+    min_shear_modulus_m: float
+
+    def __post_init__(self) -> None:
+        _positive(self, 'max_current_a', 'speed_loop_time_constant_s',
+                  'speed_loop_stiffness_n_per_mps', 'lateral_slip_speed_mps')
+
+
+@dataclass(frozen=True)
+class WaterParams:
+    """Propellers, hydrodynamic drag and added mass in the plane."""
+
+    yaw_inertia_kg_m2: float
+    surge_added_mass_ratio: float
+    sway_added_mass_ratio: float
+    yaw_added_inertia_ratio: float
+    surge_linear_drag_n_per_mps: float
+    surge_quadratic_drag_n_per_mps2: float
+    sway_linear_drag_n_per_mps: float
+    sway_quadratic_drag_n_per_mps2: float
+    yaw_linear_drag_nm_per_rps: float
+    yaw_quadratic_drag_nm_per_rps2: float
+    prop_x_m: float
+    prop_walk_ratio: float
+    prop_max_current_a: float
+    track_paddle_coeff_n_per_mps2: float
+
+    def __post_init__(self) -> None:
+        _positive(self, 'yaw_inertia_kg_m2', 'surge_quadratic_drag_n_per_mps2')
+
+
+@dataclass(frozen=True)
+class SeakeepingParams:
+    """Measured natural frequencies and damping (vehicle.md section 5)."""
+
+    heave_natural_hz: float
+    roll_natural_hz: float
+    pitch_natural_hz: float
+    heave_damping_ratio: float
+    roll_damping_ratio: float
+    pitch_damping_ratio: float
+
+    def __post_init__(self) -> None:
+        _positive(self, 'heave_natural_hz', 'roll_natural_hz', 'pitch_natural_hz')
+        for name in ('heave_damping_ratio', 'roll_damping_ratio', 'pitch_damping_ratio'):
+            if not 0.0 <= getattr(self, name) < 1.0:
+                raise ConfigError(f'seakeeping.{name} must be in [0, 1)')
+
+
+@dataclass(frozen=True)
+class StartParams:
+    """Where reset() puts the vehicle (x along the beach, m; yaw 0 faces the sea)."""
+
+    sand_x_m: float
+    surf_x_m: float
+    afloat_x_m: float
+
+
+@dataclass(frozen=True)
+class SimParams:
+    """Everything the simulator core needs beyond the shared Vehicle."""
+
+    dt_s: float
+    battery_internal_resistance_ohm: float
+    world: WorldParams
+    waves: WaveParams
+    land: LandParams
+    water: WaterParams
+    seakeeping: SeakeepingParams
+    start: StartParams
+    dry_soil: SoilParams | None
+
+    @classmethod
+    def from_params(cls, params: Mapping[str, ParamValue]) -> 'SimParams':
+        """Build from dotted parameters (the sim_node block overlaid on the shared one)."""
+        world = _build(WorldParams, params, 'world')
+        dry = soil_params(params, world.dry_soil_preset) if world.dry_soil_preset else None
+        dt = require(params, 'physics.dt_s')
+        if not 0.0 < dt <= 0.02:
+            raise ConfigError('physics.dt_s must be in (0, 0.02] s')
+        out = cls(dt, require(params, 'physics.battery_internal_resistance_ohm'), world,
+                  _build(WaveParams, params, 'waves'), _build(LandParams, params, 'land'),
+                  _build(WaterParams, params, 'water'),
+                  _build(SeakeepingParams, params, 'seakeeping'),
+                  _build(StartParams, params, 'start'), dry)
+        return out
+
+
+def apply_overrides(params: Mapping[str, ParamValue],
+                    overrides: Mapping[str, ParamValue] | None) -> dict[str, ParamValue]:
+    """Return ``params`` with dotted ``overrides`` applied; unknown names raise ConfigError.
+
+    ``world.beach_slope_rad`` / ``world.sea_floor_depth_m`` are accepted for the
+    shared ``site.*`` names.
+    """
+    out = dict(params)
+    for name, value in (overrides or {}).items():
+        key = SITE_ALIASES.get(name, name)
+        if key not in out:
+            raise ConfigError(f'unknown simulator parameter {name!r}')
+        if isinstance(value, float) and not math.isfinite(value):
+            raise ConfigError(f'parameter {name!r} must be finite, got {value!r}')
+        out[key] = value
+    return out

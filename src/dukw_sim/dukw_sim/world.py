@@ -1,0 +1,256 @@
+"""The world the vehicle moves in: beach profile, mean waterline and wave field.
+
+Frame ``odom`` (ENU): z = 0 at the mean water level, x seaward, the mean waterline
+is the line x = 0 on the beach, land at x < 0. The beach is flat sand landward of
+``flat_start_x_m``, then a plane slope (``beach_slope_rad``) down to the flat sea
+floor at ``-sea_floor_depth_m``.
+
+Waves are linear (Airy) components travelling shoreward (towards -x, spread by a
+small angle), all with the dispersion of one reference depth so that phases stay
+coherent over the sloping bed; the kinematics (particle velocity, acceleration)
+use the local depth. Depth-limited breaking caps the wave height at
+``breaking_ratio`` times the local still-water depth, so the dry beach stays dry.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+GRAVITY_MPS2 = 9.81
+_MIN_KINEMATIC_DEPTH_M = 0.05
+
+
+class WaveModel:
+    """Names of the wave models ``waves.model`` may take."""
+
+    NONE = 'none'
+    REGULAR = 'regular'
+    IRREGULAR = 'irregular'
+    ALL = (NONE, REGULAR, IRREGULAR)
+
+
+@dataclass(frozen=True)
+class Beach:
+    """Flat sand, a plane slope through the mean waterline, a flat sea floor."""
+
+    slope_rad: float
+    sea_floor_depth_m: float
+    flat_start_x_m: float
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.slope_rad < 0.6:
+            raise ValueError(f'beach slope must be in (0, 0.6) rad, got {self.slope_rad}')
+        if self.sea_floor_depth_m <= 0.0:
+            raise ValueError('sea floor depth must be > 0 m')
+        if self.flat_start_x_m >= 0.0:
+            raise ValueError('the flat sand must start landward of the waterline (x < 0)')
+        object.__setattr__(self, '_tan', math.tan(self.slope_rad))
+        object.__setattr__(self, '_floor_x', self.sea_floor_depth_m / math.tan(self.slope_rad))
+
+    @property
+    def sea_floor_x_m(self) -> float:
+        """Where the slope meets the sea floor, m."""
+        return self._floor_x
+
+    @property
+    def sand_height_m(self) -> float:
+        """Height of the flat sand above mean water level, m."""
+        return -self.flat_start_x_m * self._tan
+
+    def height_m(self, x_m: float) -> float:
+        """Ground (sand or sea bed) height at x, odom z, m."""
+        x = min(max(x_m, self.flat_start_x_m), self._floor_x)
+        return -x * self._tan
+
+    def gradient(self, x_m: float) -> float:
+        """dz/dx of the ground at x (negative on the slope)."""
+        return -self._tan if self.flat_start_x_m < x_m < self._floor_x else 0.0
+
+    def heights_m(self, x_m: np.ndarray) -> np.ndarray:
+        """Vectorised ``height_m``."""
+        return -np.clip(x_m, self.flat_start_x_m, self._floor_x) * self._tan
+
+    def distance_along_slope_m(self, x_m: float) -> float:
+        """Signed distance from the mean waterline measured along the ground, m."""
+        x = min(max(x_m, self.flat_start_x_m), self._floor_x)
+        return x / math.cos(self.slope_rad) + (x_m - x)
+
+
+def wavenumber(omega_rps: float, depth_m: float) -> float:
+    """Linear dispersion omega^2 = g k tanh(k h), solved for k by Newton's method."""
+    if omega_rps <= 0.0 or depth_m <= 0.0:
+        raise ValueError('wavenumber needs omega > 0 and depth > 0')
+    k = max(omega_rps ** 2 / GRAVITY_MPS2, omega_rps / math.sqrt(GRAVITY_MPS2 * depth_m))
+    for _ in range(50):
+        th = math.tanh(k * depth_m)
+        f = GRAVITY_MPS2 * k * th - omega_rps ** 2
+        df = GRAVITY_MPS2 * (th + k * depth_m * (1.0 - th * th))
+        step = f / df
+        k -= step
+        if abs(step) < 1e-12 * k:
+            break
+    return k
+
+
+def jonswap_density(freq_hz: np.ndarray, significant_height_m: float, peak_period_s: float,
+                    gamma: float) -> np.ndarray:
+    """JONSWAP spectral density S(f), m^2/Hz, scaled so that 4 sqrt(m0) = Hs on its own grid.
+
+    gamma = 1 gives the Pierson-Moskowitz shape.
+    """
+    fp = 1.0 / peak_period_s
+    f = np.asarray(freq_hz, dtype=float)
+    sigma = np.where(f <= fp, 0.07, 0.09)
+    peak = gamma ** np.exp(-((f - fp) ** 2) / (2.0 * sigma ** 2 * fp ** 2))
+    shape = f ** -5 * np.exp(-1.25 * (fp / f) ** 4) * peak
+    m0 = np.trapezoid(shape, f)
+    return shape * (significant_height_m / 4.0) ** 2 / m0
+
+
+@dataclass(frozen=True)
+class WaveComponents:
+    """Linear wave components: amplitude, angular frequency, wavenumber vector, phase."""
+
+    amplitude_m: np.ndarray
+    omega_rps: np.ndarray
+    kx: np.ndarray      # wavenumber vector (points where the crest travels), rad/m
+    ky: np.ndarray
+    phase_rad: np.ndarray
+
+    @property
+    def height_scale_m(self) -> float:
+        """Height used for depth-limited breaking: H (regular) or Hs (irregular), m."""
+        return 4.0 * math.sqrt(0.5 * float(np.sum(self.amplitude_m ** 2)))
+
+    @property
+    def count(self) -> int:
+        """Number of components."""
+        return int(self.amplitude_m.size)
+
+
+def regular_waves(height_m: float, period_s: float, reference_depth_m: float,
+                  direction_rad: float = math.pi) -> WaveComponents:
+    """One component of height H and period T travelling along ``direction_rad``."""
+    omega = 2.0 * math.pi / period_s
+    k = wavenumber(omega, reference_depth_m)
+    return WaveComponents(np.array([height_m / 2.0]), np.array([omega]),
+                          np.array([k * math.cos(direction_rad)]),
+                          np.array([k * math.sin(direction_rad)]), np.array([0.0]))
+
+
+def irregular_waves(significant_height_m: float, peak_period_s: float, reference_depth_m: float,
+                    rng: np.random.Generator, count: int = 32, gamma: float = 3.3,
+                    spreading_rad: float = 0.0,
+                    direction_rad: float = math.pi) -> WaveComponents:
+    """A JONSWAP sea as ``count`` components with random frequencies, phases and directions.
+
+    Frequencies are drawn uniformly inside equal bins over [0.5, 3] f_peak (no
+    repetition period); amplitudes a = sqrt(2 S(f) df), rescaled so that the
+    components' 4 sqrt(m0) equals Hs exactly.
+    """
+    if count < 1:
+        raise ValueError('an irregular sea needs at least one component')
+    fp = 1.0 / peak_period_s
+    edges = np.linspace(0.5 * fp, 3.0 * fp, count + 1)
+    df = np.diff(edges)
+    freq = edges[:-1] + rng.uniform(0.0, 1.0, count) * df
+    dense = np.linspace(edges[0], edges[-1], 400)
+    density = np.interp(freq, dense,
+                        jonswap_density(dense, significant_height_m, peak_period_s, gamma))
+    amplitude = np.sqrt(2.0 * density * df)
+    m0 = 0.5 * float(np.sum(amplitude ** 2))
+    if m0 > 0.0:
+        amplitude *= significant_height_m / (4.0 * math.sqrt(m0))
+    omega = 2.0 * math.pi * freq
+    k = np.array([wavenumber(w, reference_depth_m) for w in omega])
+    heading = direction_rad + spreading_rad * rng.uniform(-1.0, 1.0, count)
+    phase = rng.uniform(0.0, 2.0 * math.pi, count)
+    return WaveComponents(amplitude, omega, k * np.cos(heading), k * np.sin(heading), phase)
+
+
+def no_waves() -> WaveComponents:
+    """Calm water."""
+    empty = np.zeros(0)
+    return WaveComponents(empty, empty, empty, empty, empty)
+
+
+@dataclass(frozen=True)
+class WaterSample:
+    """The water at a set of points: surface elevation, and particle kinematics.
+
+    Velocity and acceleration are horizontal, in odom, at the points' heights
+    (clipped into the water column).
+    """
+
+    elevation_m: np.ndarray
+    velocity_x_mps: np.ndarray
+    velocity_y_mps: np.ndarray
+    accel_x_mps2: np.ndarray
+    accel_y_mps2: np.ndarray
+
+
+class World:
+    """Beach plus waves: ground height, water surface, depth and kinematics anywhere."""
+
+    def __init__(self, beach: Beach, waves: WaveComponents, breaking_ratio: float = 0.78,
+                 reference_depth_m: float = 0.76) -> None:
+        if breaking_ratio <= 0.0:
+            raise ValueError('breaking_ratio must be > 0')
+        self.beach = beach
+        self.waves = waves
+        self.breaking_ratio = breaking_ratio
+        self.reference_depth_m = reference_depth_m
+        self._height_scale = waves.height_scale_m if waves.count else 0.0
+        self._k = np.hypot(waves.kx, waves.ky)
+
+    @property
+    def calm(self) -> bool:
+        """True when there are no waves."""
+        return self.waves.count == 0 or self._height_scale == 0.0
+
+    def breaking_factor(self, still_depth_m: np.ndarray) -> np.ndarray:
+        """Wave-height factor in [0, 1]: H <= breaking_ratio * local still-water depth."""
+        if self.calm:
+            return np.zeros_like(still_depth_m)
+        cap = self.breaking_ratio * np.maximum(still_depth_m, 0.0) / self._height_scale
+        return np.minimum(cap, 1.0)
+
+    def sample(self, x_m: np.ndarray, y_m: np.ndarray, z_m: np.ndarray,
+               t_s: float) -> WaterSample:
+        """Surface elevation and particle kinematics at points (x, y) and heights z, time t."""
+        x = np.asarray(x_m, dtype=float)
+        if self.calm:
+            zero = np.zeros_like(x)
+            return WaterSample(zero, zero, zero, zero, zero)
+        w = self.waves
+        still = -self.beach.heights_m(x)
+        factor = self.breaking_factor(still)
+        phase = (np.multiply.outer(x, w.kx) + np.multiply.outer(np.asarray(y_m, float), w.ky)
+                 - w.omega_rps * t_s + w.phase_rad)
+        cos_p = np.cos(phase)
+        sin_p = np.sin(phase)
+        eta = factor * (cos_p @ w.amplitude_m)
+        depth = np.maximum(still, _MIN_KINEMATIC_DEPTH_M)
+        zc = np.clip(np.asarray(z_m, dtype=float), -depth, 0.0)
+        kh = np.multiply.outer(depth, self._k)
+        kz = np.multiply.outer(zc + depth, self._k)
+        transfer = np.cosh(kz) / np.sinh(kh)               # cosh k(z+h) / sinh kh
+        speed = transfer * (w.amplitude_m * w.omega_rps)   # |u| per component
+        along_x = w.kx / self._k
+        along_y = w.ky / self._k
+        vel = speed * cos_p
+        acc = speed * w.omega_rps * sin_p
+        return WaterSample(eta,
+                           factor * (vel @ along_x), factor * (vel @ along_y),
+                           factor * (acc @ along_x), factor * (acc @ along_y))
+
+    def elevation_m(self, x_m: float, y_m: float, t_s: float) -> float:
+        """Water surface above mean level at one point, m."""
+        return float(self.sample(np.array([x_m]), np.array([y_m]), np.array([0.0]),
+                                 t_s).elevation_m[0])
+
+    def water_depth_m(self, x_m: float, y_m: float, t_s: float) -> float:
+        """Surface minus ground at one point, m (<= 0 on dry sand)."""
+        return self.elevation_m(x_m, y_m, t_s) - self.beach.height_m(x_m)
