@@ -1,17 +1,109 @@
-"""drive_controller_node: skeleton (filled in by its own issue)."""
-from rclpy.node import Node
+"""drive_controller_node: cmd_vel -> tracks/cmd and props/cmd within the vehicle's limits.
 
-from dukw_common.node_tools import ParamSpec, declare_parameters, run_node
+A thin shell around dukw_control.controller.DriveController: it converts messages,
+runs the core at ``rate_hz`` and publishes the commands (neutral on shutdown).
+"""
+from diagnostic_msgs.msg import DiagnosticArray
+from dukw_msgs.msg import Authority, DiffCommand, DrivetrainStatus, DriveMode, Traction
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from rclpy.node import Node
+from sensor_msgs.msg import Imu
+
+from dukw_common.config import ConfigError
+from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
+                                    declare_parameters, diagnostic_array, run_node,
+                                    vehicle_specs)
+from dukw_control.controller import NODE_PARAMS, DriveController, settings_from_params
+from dukw_control.convert import (authority_usable, decision_from_msg, diff_command,
+                                  pitch_from_imu)
+from dukw_control.mixer import NEUTRAL
 
 
 class DriveControllerNode(Node):
-    """Skeleton: declares its parameters from config/ and idles."""
+    """Subscribes the requests and the vehicle's state; publishes guarded commands."""
 
     def __init__(self) -> None:
         super().__init__('drive_controller_node')
-        self.params = declare_parameters(self, [
-            ParamSpec('rate_hz', 'main loop rate, Hz', min=0.1, max=1000.0),
-        ])
+        specs = [ParamSpec(n, d, min=lo, max=hi) for n, d, lo, hi in NODE_PARAMS]
+        params = declare_parameters(self, specs + vehicle_specs('vehicle', 'drivetrain',
+                                                                'limits'))
+        try:
+            self.core = DriveController(settings_from_params(params))
+        except ValueError as exc:
+            raise ConfigError(f'drive_controller_node: {exc}') from exc
+        self.tracks_pub = self.create_publisher(DiffCommand, 'tracks/cmd', COMMAND_QOS)
+        self.props_pub = self.create_publisher(DiffCommand, 'props/cmd', COMMAND_QOS)
+        self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
+        self.create_subscription(Twist, 'cmd_vel', self.on_cmd_vel, COMMAND_QOS)
+        self.create_subscription(Authority, 'authority', self.on_authority, STATE_QOS)
+        self.create_subscription(DriveMode, 'drive_mode', self.on_mode, STATE_QOS)
+        self.create_subscription(Odometry, 'odometry/filtered', self.on_odometry, SENSOR_QOS)
+        self.create_subscription(Imu, 'imu/data', self.on_imu, SENSOR_QOS)
+        self.create_subscription(Traction, 'traction', self.on_traction, SENSOR_QOS)
+        self.create_subscription(DrivetrainStatus, 'tracks/status', self.on_tracks, SENSOR_QOS)
+        self.create_subscription(DrivetrainStatus, 'props/status', self.on_props, SENSOR_QOS)
+        self.props_connected = None
+        self.last_reason = None
+        self.create_timer(1.0 / params['rate_hz'], self.on_timer)
+        self.create_timer(1.0, self.publish_diagnostics)
+
+    def now_s(self) -> float:
+        """Node clock (sim time under use_sim_time), seconds."""
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def on_cmd_vel(self, msg: Twist) -> None:
+        if not self.core.on_cmd_vel(msg.linear.x, msg.angular.z, self.now_s()):
+            self.get_logger().warn(f'cmd_vel rejected: {self.core.i.last_rejection}',
+                                   throttle_duration_sec=1.0)
+
+    def on_authority(self, msg: Authority) -> None:
+        usable, detail = authority_usable(msg)
+        self.core.on_authority(usable, detail, self.now_s())
+        if not usable:
+            self.on_timer()          # neutral at once, not at the next tick
+
+    def on_mode(self, msg: DriveMode) -> None:
+        self.core.on_mode(decision_from_msg(msg))
+
+    def on_odometry(self, msg: Odometry) -> None:
+        self.core.on_odometry(msg.twist.twist.linear.x, msg.twist.twist.angular.z,
+                              self.now_s())
+
+    def on_imu(self, msg: Imu) -> None:
+        self.core.on_pitch(pitch_from_imu(msg), self.now_s())
+
+    def on_traction(self, msg: Traction) -> None:
+        self.core.on_slips(msg.port_slip, msg.stbd_slip, self.now_s())
+
+    def on_tracks(self, msg: DrivetrainStatus) -> None:
+        if msg.connected:            # a silent controller goes stale, and the tracks stop
+            self.core.on_track_currents(msg.port.current_a, msg.stbd.current_a, self.now_s())
+
+    def on_props(self, msg: DrivetrainStatus) -> None:
+        self.props_connected = msg.connected
+
+    def on_timer(self) -> None:
+        out = self.core.step(self.now_s())
+        stamp = self.get_clock().now().to_msg()
+        self.tracks_pub.publish(diff_command(out.tracks, stamp))
+        self.props_pub.publish(diff_command(out.props, stamp))
+        if out.neutral_reason != self.last_reason:
+            self.last_reason = out.neutral_reason
+            if out.neutral_reason:
+                self.get_logger().info(f'neutral: {out.neutral_reason}')
+            self.publish_diagnostics()
+
+    def publish_diagnostics(self) -> None:
+        healths = self.core.healths(self.now_s())
+        healths[0].values['props_connected'] = self.props_connected
+        self.diag_pub.publish(diagnostic_array(self, healths))
+
+    def on_shutdown(self) -> None:
+        """Last word: neutral on both actuators."""
+        stamp = self.get_clock().now().to_msg()
+        self.tracks_pub.publish(diff_command(NEUTRAL, stamp))
+        self.props_pub.publish(diff_command(NEUTRAL, stamp))
 
 
 def main(args=None) -> int:

@@ -1,17 +1,102 @@
-"""mode_manager_node: skeleton (filled in by its own issue)."""
+"""mode_manager_node: decides LAND / TRANSITION / WATER / SAFE_STOP and publishes drive_mode.
+
+A thin shell around dukw_control.modes.ModeManager: drive_mode (transient local)
+on every change with its reason and every ``republish_period_s``; the service
+``set_mode`` forces a mode or returns to automatic.
+"""
+from diagnostic_msgs.msg import DiagnosticArray
+from dukw_msgs.msg import Depth, DrivetrainStatus, DriveMode, Traction, WaterContact
+from dukw_msgs.srv import SetMode
 from rclpy.node import Node
 
-from dukw_common.node_tools import ParamSpec, declare_parameters, run_node
+from dukw_common.config import ConfigError
+from dukw_common.diagnostics import Health, Level
+from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
+                                    declare_parameters, diagnostic_array, run_node)
+from dukw_control.convert import decision_to_msg
+from dukw_control.modes import NODE_PARAMS, Mode, ModeManager, settings_from_params
 
 
 class ModeManagerNode(Node):
-    """Skeleton: declares its parameters from config/ and idles."""
+    """Feeds the state machine and publishes its decisions."""
 
     def __init__(self) -> None:
         super().__init__('mode_manager_node')
-        self.params = declare_parameters(self, [
-            ParamSpec('rate_hz', 'main loop rate, Hz', min=0.1, max=1000.0),
-        ])
+        specs = [ParamSpec(n, d, min=lo, max=hi) for n, d, lo, hi in NODE_PARAMS]
+        params = declare_parameters(self, specs)
+        try:
+            self.core = ModeManager(settings_from_params(params))
+        except ValueError as exc:
+            raise ConfigError(f'mode_manager_node: {exc}') from exc
+        self.republish_period_s = params['republish_period_s']
+        self.last_publish_s = -1e9
+        self.mode_pub = self.create_publisher(DriveMode, 'drive_mode', STATE_QOS)
+        self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
+        self.create_subscription(WaterContact, 'water/contact', self.on_contact, SENSOR_QOS)
+        self.create_subscription(Depth, 'depth', self.on_depth, SENSOR_QOS)
+        self.create_subscription(Traction, 'traction', self.on_traction, SENSOR_QOS)
+        self.create_subscription(DrivetrainStatus, 'tracks/status', self.on_tracks, SENSOR_QOS)
+        self.create_service(SetMode, 'set_mode', self.on_set_mode)
+        self.create_timer(1.0 / params['rate_hz'], self.on_timer)
+        self.create_timer(1.0, self.publish_diagnostics)
+
+    def now_s(self) -> float:
+        """Node clock (sim time under use_sim_time), seconds."""
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def on_contact(self, msg: WaterContact) -> None:
+        self.core.on_water_contact(msg.fore_wet, msg.aft_wet, self.now_s())
+
+    def on_depth(self, msg: Depth) -> None:
+        self.core.on_depth(msg.valid, msg.depth_m, self.now_s())
+
+    def on_traction(self, msg: Traction) -> None:
+        self.core.on_traction(msg.weight_on_tracks_fraction, self.now_s())
+
+    def on_tracks(self, msg: DrivetrainStatus) -> None:
+        if msg.connected:
+            self.core.on_track_forces(msg.port.force_n, msg.stbd.force_n, self.now_s())
+
+    def on_set_mode(self, request: SetMode.Request, response: SetMode.Response):
+        if request.automatic:
+            self.core.release(self.now_s())
+        else:
+            try:
+                self.core.force(Mode(request.mode), self.now_s())
+            except ValueError:
+                response.success, response.message = False, f'unknown mode {request.mode}'
+                return response
+        self.on_timer()
+        decision = self.core.decision()
+        response.success = True
+        response.message = f'{decision.mode.name}: {decision.reason}'
+        return response
+
+    def on_timer(self) -> None:
+        now = self.now_s()
+        decision = self.core.update(now)
+        if self.core.changed or now - self.last_publish_s >= self.republish_period_s:
+            if self.core.changed:
+                self.get_logger().info(f'drive mode {decision.mode.name}: {decision.reason}')
+            self.core.changed = False
+            self.last_publish_s = now
+            self.mode_pub.publish(decision_to_msg(decision, self.get_clock().now().to_msg()))
+
+    def publish_diagnostics(self) -> None:
+        now = self.now_s()
+        decision = self.core.decision()
+        health = Health('mode', message=f'{decision.mode.name}: {decision.reason}', values={
+            'automatic': decision.automatic,
+            'weight_on_tracks_fraction': f'{self.core.weight_fraction:.2f}',
+            'track_force_n': f'{self.core.track_force_n:.0f}',
+            'fore_wet': self.core.fore_wet, 'aft_wet': self.core.aft_wet,
+            'depth_valid': self.core.depth_valid, 'rejected_inputs': self.core.rejected,
+            **{f'{k}_age_s': f'{v:.2f}' for k, v in self.core.input_ages(now).items()}})
+        if decision.mode == Mode.SAFE_STOP:
+            health.level = Level.ERROR
+        elif not decision.automatic:
+            health.level = Level.WARN
+        self.diag_pub.publish(diagnostic_array(self, [health]))
 
 
 def main(args=None) -> int:

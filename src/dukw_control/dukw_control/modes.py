@@ -1,0 +1,323 @@
+"""The mode manager's state machine: on land, in the transition, afloat, or stopped.
+
+ROS-free. Evidence (vehicle.md sections 2 and 6): the debounced fore/aft water
+contact, a valid depth (the sounder reads only deeper than about 0.5 m), the
+estimator's fraction of the weight on the tracks, and the track force falling
+to drivetrain friction once the hulls carry the weight. Every change needs its
+evidence held for a debounce time, entry and exit thresholds differ
+(hysteresis), and a mode is kept for a minimum dwell time, so waves washing
+over the sensors do not make it chatter. The order is always
+LAND <-> TRANSITION <-> WATER; a needed input going stale gives SAFE_STOP.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import IntEnum
+from typing import Mapping
+
+from dukw_common.config import ParamValue, require
+
+
+class Mode(IntEnum):
+    """Drive modes (same values as dukw_msgs/DriveMode)."""
+
+    LAND = 0
+    TRANSITION = 1
+    WATER = 2
+    SAFE_STOP = 3
+
+
+#: mode_manager_node parameters: (name, description, min, max). Defaults live in config.
+NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
+    ('rate_hz', 'decision rate, Hz', 1.0, 1000.0),
+    ('republish_period_s', 'drive_mode is re-sent this often even without a change, s',
+     0.1, 60.0),
+    ('transition_enter_fraction', 'weight on tracks below this: transition', 0.0, 1.0),
+    ('land_enter_fraction', 'weight on tracks above this, sensors dry: land', 0.0, 1.0),
+    ('water_enter_fraction', 'weight on tracks below this, force at friction: water', 0.0, 1.0),
+    ('water_exit_fraction', 'weight on tracks above this afloat: transition', 0.0, 1.0),
+    ('friction_force_n', 'per-track force at drivetrain friction, N', 0.0, 2000.0),
+    ('ground_force_n', 'per-track force meaning ground contact afloat, N', 0.0, 2000.0),
+    ('force_time_constant_s', 'low-pass of the track force, s', 0.0, 60.0),
+    ('enter_transition_s', 'debounce land -> transition, s', 0.0, 60.0),
+    ('enter_water_s', 'debounce transition -> water, s', 0.0, 60.0),
+    ('exit_water_s', 'debounce water -> transition, s', 0.0, 60.0),
+    ('enter_land_s', 'debounce transition -> land, s', 0.0, 60.0),
+    ('min_dwell_s', 'a mode is kept at least this long, s', 0.0, 600.0),
+    ('transition_track_weight', 'share of the request to the tracks in the transition',
+     0.0, 1.0),
+    ('transition_prop_weight', 'share of the request to the props in the transition', 0.0, 1.0),
+    ('water_tracks_idle', 'afloat: tracks idle (true) or off (false)', None, None),
+    ('water_contact_timeout_s', 'older water/contact: safe stop, s', 0.01, 60.0),
+    ('traction_timeout_s', 'older traction: safe stop, s', 0.01, 60.0),
+    ('tracks_status_timeout_s', 'older tracks/status: safe stop, s', 0.01, 60.0),
+    ('depth_timeout_s', 'older depth counts as not valid, s', 0.01, 60.0),
+)
+
+
+def settings_from_params(params: Mapping[str, ParamValue]) -> 'ModeSettings':
+    """Build ModeSettings from dotted parameters (mode_manager_node block)."""
+    values = {}
+    for name in ModeSettings.__dataclass_fields__:
+        values[name] = require(params, name, bool if name == 'water_tracks_idle' else float)
+    return ModeSettings(**values)
+
+
+@dataclass(frozen=True)
+class ModeSettings:
+    """Thresholds, debounce and dwell times, actuator weights (config mode_manager_node)."""
+
+    transition_enter_fraction: float  # weight on tracks below this: the water carries some
+    land_enter_fraction: float        # back above this (and both sensors dry): on land
+    water_enter_fraction: float       # below this (and force at friction): afloat
+    water_exit_fraction: float        # back above this: the tracks carry weight again
+    friction_force_n: float           # per-track force at or below drivetrain friction
+    ground_force_n: float             # per-track force that means ground contact afloat
+    force_time_constant_s: float      # low-pass of the track force (intermittent contact)
+    enter_transition_s: float         # debounce of each change
+    enter_water_s: float
+    exit_water_s: float
+    enter_land_s: float
+    min_dwell_s: float                # a mode is kept at least this long
+    transition_track_weight: float
+    transition_prop_weight: float
+    water_tracks_idle: bool           # afloat: tracks idle (True) or off (False)
+    water_contact_timeout_s: float    # inputs older than these are stale
+    traction_timeout_s: float
+    tracks_status_timeout_s: float
+    depth_timeout_s: float
+
+    def __post_init__(self) -> None:
+        fractions = (self.water_enter_fraction, self.water_exit_fraction,
+                     self.transition_enter_fraction, self.land_enter_fraction)
+        if not all(0.0 <= f <= 1.0 for f in fractions):
+            raise ValueError('mode fractions must lie in [0, 1]')
+        if not self.water_enter_fraction < self.water_exit_fraction:
+            raise ValueError('water_enter_fraction must be below water_exit_fraction')
+        if not self.transition_enter_fraction < self.land_enter_fraction:
+            raise ValueError('transition_enter_fraction must be below land_enter_fraction')
+        if not self.friction_force_n < self.ground_force_n:
+            raise ValueError('friction_force_n must be below ground_force_n')
+        for name in ('transition_track_weight', 'transition_prop_weight'):
+            if not 0.0 <= getattr(self, name) <= 1.0:
+                raise ValueError(f'{name} must lie in [0, 1]')
+
+
+@dataclass(frozen=True)
+class ModeDecision:
+    """What the manager publishes on drive_mode."""
+
+    mode: Mode
+    automatic: bool
+    track_weight: float
+    prop_weight: float
+    tracks_idle: bool
+    reason: str
+
+
+class Debounce:
+    """True once a condition has held continuously for ``hold_s``."""
+
+    def __init__(self, hold_s: float) -> None:
+        self.hold_s = hold_s
+        self._since: float | None = None
+
+    def update(self, condition: bool, now_s: float) -> bool:
+        """Feed the condition at ``now_s``; return whether it has held long enough."""
+        if not condition:
+            self._since = None
+            return False
+        if self._since is None:
+            self._since = now_s
+        return now_s - self._since >= self.hold_s
+
+    def reset(self) -> None:
+        """Forget how long the condition has held."""
+        self._since = None
+
+
+class ModeManager:
+    """Feed it inputs (``on_*``) and call ``update(now_s)`` at a fixed rate."""
+
+    def __init__(self, settings: ModeSettings) -> None:
+        self.s = settings
+        self._stamps: dict[str, float] = {}
+        self.fore_wet = self.aft_wet = False
+        self.depth_valid = False
+        self.weight_fraction = 1.0
+        self.track_force_n = 0.0         # low-passed max of |port|, |stbd|
+        self.rejected = 0
+        self._forced: Mode | None = None
+        self._mode = Mode.SAFE_STOP
+        self._since_s = -math.inf
+        self._reason = 'waiting for inputs'
+        self.changed = True
+        self._to_transition = Debounce(settings.enter_transition_s)
+        self._to_water = Debounce(settings.enter_water_s)
+        self._from_water = Debounce(settings.exit_water_s)
+        self._to_land = Debounce(settings.enter_land_s)
+
+    # --- inputs -----------------------------------------------------------------------
+    def on_water_contact(self, fore_wet: bool, aft_wet: bool, now_s: float) -> None:
+        """Debounced fore/aft wet flags from the water-contact sensors."""
+        self.fore_wet, self.aft_wet = bool(fore_wet), bool(aft_wet)
+        self._stamps['water/contact'] = now_s
+
+    def on_depth(self, valid: bool, depth_m: float, now_s: float) -> None:
+        """Depth sounder: valid only in water deeper than about 0.5 m."""
+        self.depth_valid = bool(valid) and math.isfinite(depth_m) and depth_m > 0.0
+        self._stamps['depth'] = now_s
+
+    def on_traction(self, weight_on_tracks_fraction: float, now_s: float) -> bool:
+        """The estimator's fraction of the weight on the tracks; False if rejected (NaN)."""
+        f = weight_on_tracks_fraction
+        if not math.isfinite(f):
+            self.rejected += 1
+            return False
+        self.weight_fraction = min(max(f, 0.0), 1.0)
+        self._stamps['traction'] = now_s
+        return True
+
+    def on_track_forces(self, port_n: float, stbd_n: float, now_s: float) -> bool:
+        """Measured track forces (current x gain); low-passed; False if rejected."""
+        if not (math.isfinite(port_n) and math.isfinite(stbd_n)):
+            self.rejected += 1
+            return False
+        force = max(abs(port_n), abs(stbd_n))
+        last = self._stamps.get('tracks/status')
+        if last is None:
+            self.track_force_n = force
+        else:
+            dt = min(max(now_s - last, 0.0), 1.0)
+            alpha = dt / (self.s.force_time_constant_s + dt) if dt > 0 else 0.0
+            self.track_force_n += alpha * (force - self.track_force_n)
+        self._stamps['tracks/status'] = now_s
+        return True
+
+    # --- operator ---------------------------------------------------------------------
+    def force(self, mode: Mode, now_s: float) -> None:
+        """Hold ``mode`` until ``release``; the inputs no longer decide (operator's call)."""
+        self._forced = Mode(mode)
+        self._enter(self._forced, now_s, f'forced to {self._forced.name} by the operator')
+
+    def release(self, now_s: float) -> None:
+        """Return to automatic decisions, starting from the mode the evidence shows now."""
+        self._forced = None
+        stale = self._stale(now_s)
+        if stale:
+            self._enter(Mode.SAFE_STOP, now_s, f'back to automatic; {stale}')
+        else:
+            mode, why = self._classify()
+            self._enter(mode, now_s, f'back to automatic: {why}')
+
+    @property
+    def automatic(self) -> bool:
+        """False while an operator forces the mode."""
+        return self._forced is None
+
+    @property
+    def mode(self) -> Mode:
+        """The current mode."""
+        return self._mode
+
+    # --- decision ---------------------------------------------------------------------
+    def input_ages(self, now_s: float) -> dict[str, float]:
+        """Seconds since each input last arrived (inf if never)."""
+        names = ('water/contact', 'traction', 'tracks/status', 'depth')
+        return {n: now_s - self._stamps.get(n, -math.inf) for n in names}
+
+    def _stale(self, now_s: float) -> str:
+        ages = self.input_ages(now_s)
+        limits = {'water/contact': self.s.water_contact_timeout_s,
+                  'traction': self.s.traction_timeout_s,
+                  'tracks/status': self.s.tracks_status_timeout_s}
+        never = [n for n in limits if math.isinf(ages[n])]
+        if never:
+            return 'waiting for ' + ', '.join(never)
+        old = [f'{n} stale (no message for {limits[n]:.2f} s)' for n in limits
+               if ages[n] > limits[n]]
+        return '; '.join(old)
+
+    def _depth_ok(self, now_s: float) -> bool:
+        return self.depth_valid and self.input_ages(now_s)['depth'] <= self.s.depth_timeout_s
+
+    def _classify(self) -> tuple[Mode, str]:
+        """The mode the evidence shows at once (start-up, recovery, release)."""
+        f = self.weight_fraction
+        if f < self.s.water_enter_fraction and self.track_force_n <= self.s.friction_force_n \
+                and (self.depth_valid or (self.fore_wet and self.aft_wet)):
+            return Mode.WATER, f'afloat (weight on tracks {f:.2f})'
+        if self.fore_wet or self.aft_wet or f < self.s.transition_enter_fraction:
+            return Mode.TRANSITION, f'in the surf (weight on tracks {f:.2f}, {self._wet_text()})'
+        return Mode.LAND, f'on land (weight on tracks {f:.2f}, sensors dry)'
+
+    def _wet_text(self) -> str:
+        wet = [n for n, w in (('fore', self.fore_wet), ('aft', self.aft_wet)) if w]
+        return ' and '.join(wet) + ' wet' if wet else 'sensors dry'
+
+    def _enter(self, mode: Mode, now_s: float, reason: str) -> None:
+        if mode != self._mode or reason != self._reason:
+            self.changed = True
+        if mode != self._mode:
+            self._since_s = now_s
+            for debounce in (self._to_transition, self._to_water, self._from_water,
+                             self._to_land):
+                debounce.reset()
+        self._mode = mode
+        self._reason = reason
+
+    def update(self, now_s: float) -> ModeDecision:
+        """Decide the mode at ``now_s``; ``changed`` turns True when mode or reason changed."""
+        if self._forced is None:
+            self._decide(now_s)
+        return self.decision()
+
+    def _decide(self, now_s: float) -> None:
+        stale = self._stale(now_s)
+        if stale:
+            self._enter(Mode.SAFE_STOP, now_s, stale)
+            return
+        if self._mode == Mode.SAFE_STOP:
+            mode, why = self._classify()
+            self._enter(mode, now_s, f'inputs fresh: {why}')
+            return
+        s, f = self.s, self.weight_fraction
+        dwell_done = now_s - self._since_s >= s.min_dwell_s
+        wet_any = self.fore_wet or self.aft_wet
+        force_low = self.track_force_n <= s.friction_force_n
+        if self._mode == Mode.LAND:
+            wet = self._to_transition.update(wet_any or f < s.transition_enter_fraction, now_s)
+            if wet and dwell_done:
+                self._enter(Mode.TRANSITION, now_s,
+                            f'water reached the vehicle ({self._wet_text()}, '
+                            f'weight on tracks {f:.2f})')
+        elif self._mode == Mode.TRANSITION:
+            afloat = self._to_water.update(
+                f < s.water_enter_fraction and force_low and (
+                    self._depth_ok(now_s) or (self.fore_wet and self.aft_wet)), now_s)
+            dry = self._to_land.update(not wet_any and f > s.land_enter_fraction, now_s)
+            if afloat and dwell_done:
+                self._enter(Mode.WATER, now_s,
+                            f'afloat: weight on tracks {f:.2f}, track force '
+                            f'{self.track_force_n:.0f} N at friction')
+            elif dry and dwell_done:
+                self._enter(Mode.LAND, now_s, f'out of the water: sensors dry, weight on '
+                                              f'tracks {f:.2f}')
+        elif self._mode == Mode.WATER:
+            grounded = self._from_water.update(
+                f > s.water_exit_fraction or self.track_force_n > s.ground_force_n, now_s)
+            if grounded and dwell_done:
+                self._enter(Mode.TRANSITION, now_s,
+                            f'tracks on the ground: weight on tracks {f:.2f}, track force '
+                            f'{self.track_force_n:.0f} N')
+
+    def decision(self) -> ModeDecision:
+        """The current decision with its actuator weights."""
+        s = self.s
+        weights = {Mode.LAND: (1.0, 0.0, False),
+                   Mode.TRANSITION: (s.transition_track_weight, s.transition_prop_weight, False),
+                   Mode.WATER: (0.0, 1.0, s.water_tracks_idle),
+                   Mode.SAFE_STOP: (0.0, 0.0, False)}
+        track_w, prop_w, idle = weights[self._mode]
+        return ModeDecision(self._mode, self.automatic, track_w, prop_w, idle, self._reason)

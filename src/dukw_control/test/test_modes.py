@@ -1,0 +1,122 @@
+"""The mode state machine: order, debounce, hysteresis, dwell, staleness, forcing."""
+import dataclasses
+
+import pytest
+
+from dukw_control.modes import Mode, ModeManager, ModeSettings
+
+DT = 0.05
+
+
+class Feed:
+    """Feeds a manager at 20 Hz with the given evidence and records mode changes."""
+
+    def __init__(self, settings):
+        self.mm = ModeManager(settings)
+        self.t = 0.0
+        self.modes = []
+
+    def run(self, seconds, fraction=1.0, fore=False, aft=False, depth=False, force_n=200.0):
+        for _ in range(int(round(seconds / DT))):
+            self.t += DT
+            self.mm.on_water_contact(fore, aft, self.t)
+            self.mm.on_traction(fraction, self.t)
+            self.mm.on_track_forces(force_n, force_n, self.t)
+            self.mm.on_depth(depth, 1.0 if depth else float('nan'), self.t)
+            d = self.mm.update(self.t)
+            if not self.modes or self.modes[-1][0] != d.mode:
+                self.modes.append((d.mode, self.t, d.reason))
+        return self.mm.decision()
+
+
+def test_starts_in_safe_stop_and_classifies_when_inputs_arrive(mode_settings):
+    mm = ModeManager(mode_settings)
+    d = mm.update(0.0)
+    assert d.mode == Mode.SAFE_STOP and 'waiting for' in d.reason
+    assert d.track_weight == 0.0 and d.prop_weight == 0.0
+    f = Feed(mode_settings)
+    assert f.run(0.2).mode == Mode.LAND
+
+
+def test_land_to_water_goes_through_transition_once_each(mode_settings):
+    f = Feed(mode_settings)
+    f.run(5.0)
+    f.run(4.0, fraction=0.6, fore=True)
+    d = f.run(6.0, fraction=0.0, fore=True, aft=True, depth=True, force_n=20.0)
+    assert [m for m, *_ in f.modes] == [Mode.LAND, Mode.TRANSITION, Mode.WATER]
+    assert d.track_weight == 0.0 and d.prop_weight == 1.0
+    assert 'afloat' in d.reason
+
+
+def test_waves_washing_over_the_sensors_do_not_make_it_chatter(mode_settings):
+    f = Feed(mode_settings)
+    f.run(2.0)
+    for _ in range(10):                      # a wave every 3.6 s wets the fore sensor 0.2 s
+        f.run(0.2, fraction=0.97, fore=True)
+        f.run(3.4, fraction=0.98)
+    assert [m for m, *_ in f.modes] == [Mode.LAND]
+    for _ in range(10):                      # in the surf: weight comes and goes with heave
+        f.run(1.0, fraction=0.5, fore=True)
+        f.run(1.0, fraction=0.95, fore=False)
+    assert [m for m, *_ in f.modes] == [Mode.LAND, Mode.TRANSITION]
+
+
+def test_afloat_intermittent_ground_contact_stays_water_until_it_holds(mode_settings):
+    f = Feed(mode_settings)
+    f.run(1.0, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    assert f.mm.mode == Mode.WATER
+    for _ in range(5):
+        f.run(0.5, fraction=0.5, fore=True, aft=True, depth=True, force_n=10.0)
+        f.run(2.0, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    assert f.mm.mode == Mode.WATER
+    f.run(3.0, fraction=0.6, fore=True, aft=True, force_n=300.0)
+    f.run(6.0, fraction=1.0)
+    assert [m for m, *_ in f.modes] == [Mode.WATER, Mode.TRANSITION, Mode.LAND]
+
+
+def test_water_needs_the_track_force_at_friction(mode_settings):
+    f = Feed(mode_settings)
+    f.run(1.0, fraction=0.5, fore=True)
+    f.run(10.0, fraction=0.05, fore=True, aft=True, depth=True, force_n=300.0)
+    assert f.mm.mode == Mode.TRANSITION
+
+
+def test_stale_input_gives_safe_stop_with_the_reason_and_recovers(mode_settings):
+    f = Feed(mode_settings)
+    f.run(1.0)
+    t = f.t + 1.0                            # nothing for 1 s
+    d = f.mm.update(t)
+    assert d.mode == Mode.SAFE_STOP
+    assert 'water/contact stale' in d.reason and 'traction stale' in d.reason
+    f.t = t
+    assert f.run(0.1).mode == Mode.LAND
+
+
+def test_nan_weight_fraction_is_rejected(mode_settings):
+    mm = ModeManager(mode_settings)
+    assert not mm.on_traction(float('nan'), 0.0)
+    assert mm.rejected == 1 and mm.weight_fraction == 1.0
+
+
+def test_forced_mode_holds_and_release_returns_to_the_evidence(mode_settings):
+    f = Feed(mode_settings)
+    f.run(1.0)
+    f.mm.force(Mode.WATER, f.t)
+    d = f.run(2.0)
+    assert d.mode == Mode.WATER and not d.automatic and 'forced' in d.reason
+    f.mm.release(f.t)
+    assert f.mm.decision().mode == Mode.LAND and f.mm.automatic
+
+
+def test_tracks_idle_afloat_is_a_parameter(mode_settings):
+    s = dataclasses.replace(mode_settings, water_tracks_idle=True)
+    f = Feed(s)
+    d = f.run(1.0, fraction=0.0, fore=True, aft=True, depth=True, force_n=0.0)
+    assert d.mode == Mode.WATER and d.tracks_idle
+
+
+def test_inconsistent_thresholds_are_refused(mode_settings):
+    with pytest.raises(ValueError):
+        dataclasses.replace(mode_settings, water_enter_fraction=0.5, water_exit_fraction=0.4)
+    with pytest.raises(ValueError):
+        ModeSettings(**{**dataclasses.asdict(mode_settings), 'transition_prop_weight': 2.0})
