@@ -17,7 +17,7 @@ from typing import Any, Iterable, Iterator, Sequence
 
 from rosbags.interfaces import (Connection, Qos, QosDurability, QosHistory, QosLiveliness,
                                 QosReliability, QosTime)
-from rosbags.rosbag2 import Reader, StoragePlugin, Writer
+from rosbags.rosbag2 import CompressionFormat, CompressionMode, Reader, StoragePlugin, Writer
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
@@ -122,13 +122,17 @@ class BagWriter:
     """Write a rosbag2 in MCAP, topic by topic; always a readable bag once ``close``d.
 
     Use as a context manager, or call ``close()`` (idempotent) from a shutdown path.
+    ``compress`` zstd-compresses the MCAP chunks (smaller; every MCAP reader handles it).
     """
 
-    def __init__(self, path: str | Path, store: Typestore | None = None) -> None:
+    def __init__(self, path: str | Path, store: Typestore | None = None,
+                 compress: bool = False) -> None:
         self.path = Path(path)
         self.store = store or typestore()
         self._writer = Writer(self.path, version=Writer.VERSION_LATEST,
                               storage_plugin=StoragePlugin.MCAP)
+        if compress:
+            self._writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)
         self._writer.open()
         self._connections: dict[str, Connection] = {}
         self.counts: dict[str, int] = {}

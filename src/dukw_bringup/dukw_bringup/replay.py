@@ -34,22 +34,25 @@ class CoreAdapter(ABC):
     name: str = ''
     #: topic keys (no leading slash) whose messages the node subscribes to
     inputs: tuple[str, ...] = ()
-    #: topic key of the output this adapter reproduces and compares
-    output_topic: str = ''
+    #: topic keys of the outputs this adapter reproduces and compares
+    outputs: tuple[str, ...] = ()
     #: the node's timer rate, Hz
     rate_hz: float = 1.0
 
     @abstractmethod
-    def feed(self, topic: str, t_s: float, msg: Any) -> None:
-        """An input message received at ``t_s`` (bag time, s)."""
+    def feed(self, topic: str, t_s: float, msg: Any) -> dict[str, float] | None:
+        """An input message received at ``t_s`` (bag time, s).
+
+        Return an output when the node reacts at once (outside its timer), else None.
+        """
 
     @abstractmethod
     def tick(self, t_s: float) -> dict[str, float]:
         """Step the core at ``t_s``; return its output as named numbers."""
 
     @abstractmethod
-    def recorded(self, msg: Any) -> dict[str, float]:
-        """The same named numbers from a recorded output message."""
+    def recorded(self, topic: str, msg: Any) -> dict[str, float]:
+        """The same named numbers from a recorded output message on ``topic``."""
 
 
 @dataclass
@@ -120,8 +123,14 @@ class _Driver:
             self.rows.append({'t_s': t_s, **self.latest})
             self.next_tick_ns += self.period_ns
 
-    def compare(self, t_ns: int, msg: Any) -> None:
-        recorded = self.adapter.recorded(msg)
+    def feed(self, topic: str, t_ns: int, msg: Any) -> None:
+        out = self.adapter.feed(topic, t_ns * 1e-9, msg)
+        if out is not None:
+            self.latest = out
+            self.rows.append({'t_s': t_ns * 1e-9, **out})
+
+    def compare(self, topic: str, t_ns: int, msg: Any) -> None:
+        recorded = self.adapter.recorded(topic, msg)
         replayed = self.latest or {}
         for quantity, value in recorded.items():
             dev = self.deviations.setdefault(quantity, Deviation(self.adapter.name, quantity))
@@ -147,12 +156,13 @@ def replay(bag: str | Path, adapters: Sequence[CoreAdapter]) -> ReplayResult:
     """Feed the bag through ``adapters``; return replayed rows and deviations."""
     bag = Path(bag)
     store = typestore()
-    outputs = {a.output_topic for a in adapters}
+    outputs = set().union(*(a.outputs for a in adapters))
     firsts = _first_output_ns(bag, outputs)
-    missing = outputs - set(firsts)
-    if missing:
-        raise BagError(f'{bag}: no recorded {sorted(missing)} to anchor the replay on')
-    drivers = [_Driver(a, firsts[a.output_topic]) for a in adapters]
+    for adapter in adapters:
+        if not any(o in firsts for o in adapter.outputs):
+            raise BagError(f'{bag}: no recorded {list(adapter.outputs)} to anchor the '
+                           f'{adapter.name} replay on')
+    drivers = [_Driver(a, min(firsts[o] for o in a.outputs if o in firsts)) for a in adapters]
     wanted = outputs.union(*(a.inputs for a in adapters))
     result = ReplayResult()
     start = time.perf_counter()
@@ -164,10 +174,10 @@ def replay(bag: str | Path, adapters: Sequence[CoreAdapter]) -> ReplayResult:
         for driver in drivers:
             driver.run_ticks_until(t_ns, inclusive=False)
             if key in driver.adapter.inputs:
-                driver.adapter.feed(key, t_ns * 1e-9, msg)
-            if key == driver.adapter.output_topic:
+                driver.feed(key, t_ns, msg)
+            if key in driver.adapter.outputs:
                 driver.run_ticks_until(t_ns, inclusive=True)
-                driver.compare(t_ns, msg)
+                driver.compare(key, t_ns, msg)
     result.elapsed_s = time.perf_counter() - start
     for driver in drivers:
         result.rows[driver.adapter.name] = driver.rows

@@ -14,7 +14,7 @@ class SumCore(CoreAdapter):
 
     name = 'sum'
     inputs = ('in',)
-    output_topic = 'out'
+    outputs = ('out',)
     rate_hz = 10.0
 
     def __init__(self) -> None:
@@ -28,7 +28,7 @@ class SumCore(CoreAdapter):
         self.ticks.append(round(t_s, 6))
         return {'total': self.total, 'ticks': float(len(self.ticks))}
 
-    def recorded(self, msg):
+    def recorded(self, topic, msg):
         return {'total': msg.port_pct, 'ticks': msg.stbd_pct}
 
 
