@@ -106,9 +106,11 @@ class ManeuverNode(Node):
         self.tracks_pub.publish(diff_command(tracks, stamp))
         self.props_pub.publish(diff_command(props, stamp))
         if player.state != before:
-            log = self.get_logger().warn if player.state == PlayerState.ABORTED else \
-                self.get_logger().info
-            log(f'{player.state.value}' + (f': {player.reason}' if player.reason else ''))
+            text = player.state.value + (f': {player.reason}' if player.reason else '')
+            if player.state == PlayerState.ABORTED:
+                self.get_logger().warn(text)
+            else:
+                self.get_logger().info(text)
         if player.state in (PlayerState.DONE, PlayerState.ABORTED):
             self.end_s = now if self.end_s is None else self.end_s
             if now - self.end_s > 0.5:    # neutral for a while, then run_node's loop ends
