@@ -9,6 +9,9 @@ file (config/stack_sim.yaml, config/stack_boat.yaml) lists the nodes:
       nodes:
         - {name: sim_node, package: dukw_sim, executable: sim_node, args: [-p, rate_hz:=100.0]}
 
+``args`` are ROS arguments (after the parameter files), ``cli_args`` the program's
+own (before ``--ros-args``), ``rename: true`` runs the node under ``name``.
+
 Each node runs as ``<prefix>/lib/<package>/<executable> --ros-args
 [-r __node:=<name>] --params-file <file>... <args>`` in its own session (so a
 terminal's Ctrl-C reaches only the runner, which then stops the nodes in
@@ -46,8 +49,9 @@ class NodeSpec:
     name: str
     package: str
     executable: str
-    args: tuple[str, ...] = ()
-    rename: bool = False   # run under ``name`` (-r __node:=name), for a second instance
+    args: tuple[str, ...] = ()      # ROS arguments, after the parameter files
+    rename: bool = False            # run under ``name`` (-r __node:=name), for a second instance
+    cli_args: tuple[str, ...] = ()  # the program's own arguments, before --ros-args
 
 
 @dataclass(frozen=True)
@@ -81,11 +85,15 @@ def parse_stack(doc: Any, source: str = 'stack') -> StackSpec:
             if not isinstance(raw.get(key), str) or not _NAME.match(raw[key]):
                 raise ConfigError(f'{source}: stack.nodes[{i}].{key} must be a plain name, '
                                   f'got {raw.get(key)!r}')
-        args = raw.get('args', [])
-        if not isinstance(args, list) or not all(isinstance(a, (str, int, float)) for a in args):
-            raise ConfigError(f'{source}: stack.nodes[{i}].args must be a list of strings')
-        nodes.append(NodeSpec(raw['name'], raw['package'], raw['executable'],
-                              tuple(str(a) for a in args), bool(raw.get('rename', False))))
+        lists = {}
+        for key in ('args', 'cli_args'):
+            value = raw.get(key, [])
+            if not isinstance(value, list) or not all(
+                    isinstance(a, (str, int, float)) for a in value):
+                raise ConfigError(f'{source}: stack.nodes[{i}].{key} must be a list of strings')
+            lists[key] = tuple(str(a) for a in value)
+        nodes.append(NodeSpec(raw['name'], raw['package'], raw['executable'], lists['args'],
+                              bool(raw.get('rename', False)), lists['cli_args']))
     names = [n.name for n in nodes]
     if len(set(names)) != len(names):
         raise ConfigError(f'{source}: node names must be unique, got {names}')
@@ -125,7 +133,8 @@ def node_executable(package: str, executable: str) -> Path:
 
 def node_command(spec: NodeSpec, params_files: Sequence[Path]) -> list[str]:
     """The command line that runs one node."""
-    command = [str(node_executable(spec.package, spec.executable)), '--ros-args']
+    command = [str(node_executable(spec.package, spec.executable)), *spec.cli_args,
+               '--ros-args']
     if spec.rename:
         command += ['-r', f'__node:={spec.name}']
     for params in params_files:

@@ -54,10 +54,9 @@ class Waypoint:
 
 @dataclass(frozen=True)
 class StartPose:
-    """Where the simulator puts the vehicle at the start (odom)."""
+    """Where the simulator puts the vehicle at the start (odom; the simulator starts on y = 0)."""
 
     x_m: float
-    y_m: float
     yaw_rad: float
 
 
@@ -150,8 +149,7 @@ def parse_mission(doc: Any) -> MissionSpec:
         raise ConfigError(f'mission: sea.seed must be an integer, got {seed!r}')
     return MissionSpec(
         name=str(tree.get('name', 'mission')),
-        start=StartPose(_number(start, 'x_m', 'start.'), _number(start, 'y_m', 'start.'),
-                        _number(start, 'yaw_rad', 'start.')),
+        start=StartPose(_number(start, 'x_m', 'start.'), _number(start, 'yaw_rad', 'start.')),
         sea=SeaState(_number(sea, 'significant_height_m', 'sea.'),
                      _number(sea, 'peak_period_s', 'sea.'), seed),
         waypoints=tuple(waypoints),
@@ -251,7 +249,7 @@ class LosGuidance:
         self.spec = spec
         self.progress = Progress(waypoints_total=len(spec.waypoints),
                                  waypoint_name=spec.waypoints[0].name)
-        self._leg_start: tuple[float, float] = (spec.start.x_m, spec.start.y_m)
+        self._leg_start: tuple[float, float] = (spec.start.x_m, 0.0)
         self._t0_s: float | None = None
 
     def start(self, t_s: float, x_m: float, y_m: float) -> None:

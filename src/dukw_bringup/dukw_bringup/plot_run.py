@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -19,7 +20,7 @@ from dukw_bringup.bag_io import BagError
 from dukw_bringup.mission import MissionSpec, load_mission
 from dukw_bringup.plots import PlotContext, write_plots
 from dukw_bringup.summary import load_run, summarize_run, summary_lines, write_summary
-from dukw_common.config import ConfigError, default_config_path
+from dukw_common.config import ConfigError, default_config_path, node_params
 from dukw_common.vehicle import Vehicle
 
 BAG_DIR = 'bag'
@@ -43,6 +44,7 @@ def render_run(run_dir: str | Path, wall_time_s: float | None = None,
     run_dir = Path(run_dir)
     config_path, mission_path = run_files(run_dir)
     vehicle = Vehicle.load(str(config_path))
+    sim = node_params('sim_node', config_path)
     mission: MissionSpec = load_mission(mission_path)
     run = load_run(run_dir / BAG_DIR)
     limit_a = vehicle.drivetrain.continuous_current_limit_a
@@ -54,6 +56,7 @@ def render_run(run_dir: str | Path, wall_time_s: float | None = None,
         sea_floor_depth_m=vehicle.site.sea_floor_depth_m,
         current_limit_a=limit_a, displacement_n=vehicle.body.displacement_n,
         displaced_volume_m3=vehicle.body.displaced_volume_m3,
+        flat_start_x_m=float(sim.get('world.flat_start_x_m', -math.inf)),
         waypoints=mission.waypoints, title=f'{mission.name}: {run_dir.name}')
     summary['plots'] = [p.name for p in write_plots(run, context, run_dir)]
     write_summary(summary, run_dir / SUMMARY_FILE)

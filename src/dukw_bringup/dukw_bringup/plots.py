@@ -32,13 +32,16 @@ class PlotContext:
     current_limit_a: float
     displacement_n: float
     displaced_volume_m3: float
+    flat_start_x_m: float = -float('inf')   # the simulator's flat sand landward of this
     waypoints: tuple[Waypoint, ...] = ()
     title: str = ''
 
 
-def beach_profile(x_m: np.ndarray, slope_rad: float, floor_depth_m: float) -> np.ndarray:
-    """Ground height above the mean water level: a plane slope down to the sea floor."""
-    return np.maximum(-np.asarray(x_m) * np.tan(slope_rad), -floor_depth_m)
+def beach_profile(x_m: np.ndarray, slope_rad: float, floor_depth_m: float,
+                  flat_start_x_m: float = -np.inf) -> np.ndarray:
+    """Ground height above the mean water level: flat sand, a plane slope, the sea floor."""
+    x = np.maximum(np.asarray(x_m, dtype=float), flat_start_x_m)
+    return np.maximum(-x * np.tan(slope_rad), -floor_depth_m)
 
 
 def _figure(rows: int, title: str):
@@ -96,7 +99,8 @@ def plot_trajectory(run: RunData, ctx: PlotContext, path: Path) -> Path:
     else:
         lo, hi = -12.0, 22.0
     grid = np.linspace(lo, hi, 400)
-    ground = beach_profile(grid, ctx.beach_slope_rad, ctx.sea_floor_depth_m)
+    ground = beach_profile(grid, ctx.beach_slope_rad, ctx.sea_floor_depth_m,
+                           ctx.flat_start_x_m)
     side.fill_between(grid, ground, ground.min() - 0.3, color='tan', label='beach (config)')
     side.fill_between(grid, ground, 0.0, where=ground < 0.0, color='lightblue', alpha=0.6,
                       label='mean sea level')

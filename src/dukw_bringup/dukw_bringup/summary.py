@@ -96,13 +96,14 @@ def load_run(bag_path: str | Path) -> RunData:
     last_ns = 0
     for message in read_messages(bag_path):
         count += 1
-        t0_ns = message.timestamp_ns if t0_ns is None else t0_ns
+        if t0_ns is None and message.timestamp_ns > 0:
+            t0_ns = message.timestamp_ns  # a sim-time recorder stamps 0 before the first /clock
         last_ns = message.timestamp_ns
         key = topic_key(message.topic)
         if key not in COLUMNS and key not in TEXT_TOPICS:
             continue
         msg = deserialize(message)
-        t_s = (message.timestamp_ns - t0_ns) * 1e-9
+        t_s = max(0.0, (message.timestamp_ns - (t0_ns or message.timestamp_ns)) * 1e-9)
         if key in COLUMNS:
             rows[key].append(tuple(float(get(msg)) for get in COLUMNS[key].values()))
             times[key].append(t_s)

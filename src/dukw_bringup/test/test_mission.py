@@ -9,7 +9,7 @@ from dukw_bringup.mission import (STOP, LosGuidance, MissionState, Progress, lin
 from dukw_common.config import ConfigError
 
 MISSION = {'mission': {
-    'name': 'test', 'start': {'x_m': -10.0, 'y_m': 0.0, 'yaw_rad': 0.0},
+    'name': 'test', 'start': {'x_m': -10.0, 'yaw_rad': 0.0},
     'sea': {'significant_height_m': 0.28, 'peak_period_s': 3.57, 'seed': 1},
     'timeout_s': 100.0, 'acceptance_radius_m': 1.0, 'lookahead_m': 3.0,
     'heading_gain_per_s': 1.0, 'max_yaw_rate_rps': 0.5, 'min_speed_fraction': 0.2,
