@@ -1,0 +1,132 @@
+"""motor_controller_node against a fake Roboteq on a pty, through real topics."""
+import math
+import time
+
+import pytest
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from dukw_msgs.msg import DrivetrainStatus, MotorSide
+
+from dukw_common.node_tools import COMMAND_QOS, parameter_overrides
+from dukw_common.testing import NodeProcess, ros_node, spin_until
+from dukw_driver.motor_controller_node import MotorControllerNode
+from fake_device import FakeDevice
+from fake_roboteq import FakeRoboteq
+
+pytestmark = pytest.mark.ros
+
+
+@pytest.fixture
+def roboteq(tmp_path):
+    emulator = FakeRoboteq()
+    with FakeDevice(tmp_path / 'ttyRoboteq', respond=emulator.feed) as device:
+        emulator.device = device
+        yield emulator
+
+
+class Graph:
+    def __init__(self, probe, executor, port, drive):
+        self.executor = executor
+        self.node = MotorControllerNode(context=probe.context,
+                                        parameter_overrides=parameter_overrides(
+                                            {'port': port, 'drive': drive}))
+        executor.add_node(self.node)
+        self.status: list[DrivetrainStatus] = []
+        self.diagnostics: list[DiagnosticStatus] = []
+        probe.create_subscription(DrivetrainStatus, f'{drive}/status', self.status.append,
+                                  COMMAND_QOS)
+        probe.create_subscription(DiagnosticArray, '/diagnostics',
+                                  lambda m: self.diagnostics.extend(m.status), COMMAND_QOS)
+
+    def spin_until(self, predicate, timeout_s=5.0):
+        return spin_until(self.executor, predicate, timeout_s)
+
+    def connected(self):
+        return bool(self.status) and self.status[-1].connected
+
+
+@pytest.fixture
+def tracks(roboteq):
+    with ros_node('probe_motor_tracks') as (probe, executor):
+        graph = Graph(probe, executor, str(roboteq.device.path), 'tracks')
+        yield graph
+        graph.node.destroy_node()
+
+
+def test_tracks_status_from_the_controller(tracks, roboteq):
+    assert tracks.spin_until(tracks.connected)
+    status = tracks.status[-1]
+    assert status.drive == DrivetrainStatus.DRIVE_TRACKS
+    assert status.port.current_a == pytest.approx(12.3)
+    assert status.port.force_n == pytest.approx(12.3 * 8.16)
+    assert status.stbd.command_pct == pytest.approx(56.0)
+    assert status.port.speed_mps == pytest.approx(1547 / 7 / 60 * math.pi * 0.1727)
+    assert status.port.voltage_v == pytest.approx(24.6) and status.port.temperature_c == 41
+    assert status.port.fault_flags == 0 and list(status.port.faults) == []
+    roboteq.fault_flags, roboteq.motor_flags = 0b10, (0b10, 0)
+    assert tracks.spin_until(lambda: tracks.status[-1].port.fault_flags != 0)
+    port = tracks.status[-1].port
+    assert port.fault_flags == MotorSide.FAULT_OVERVOLTAGE | MotorSide.FAULT_STALL
+    assert list(port.faults) == ['overvoltage', 'stall']
+    assert tracks.spin_until(lambda: any(d.level == DiagnosticStatus.ERROR
+                                         and 'overvoltage' in d.message
+                                         for d in tracks.diagnostics))
+    assert roboteq.commands == []
+
+
+def test_unplug_reports_the_loss_and_replug_publishes_again_within_2_s(tracks, roboteq):
+    assert tracks.spin_until(tracks.connected)
+    roboteq.device.unplug()
+    assert tracks.spin_until(lambda: not tracks.status[-1].connected)
+    lost = tracks.status[-1]
+    assert math.isnan(lost.port.current_a)
+    assert lost.port.fault_flags & MotorSide.FAULT_COMM_TIMEOUT
+    assert tracks.spin_until(lambda: any(d.level == DiagnosticStatus.ERROR
+                                         and 'not connected' in d.message
+                                         for d in tracks.diagnostics), timeout_s=3.0)
+    count = len(tracks.status)
+    tracks.spin_until(lambda: False, timeout_s=1.0)
+    assert len(tracks.status) > count  # keeps publishing while the device is away
+    roboteq.device.replug()
+    replugged = time.monotonic()
+    assert tracks.spin_until(tracks.connected, timeout_s=2.0)
+    assert time.monotonic() - replugged < 2.0
+    assert tracks.node.link.reconnects == 1
+    assert tracks.status[-1].port.current_a == pytest.approx(12.3)
+
+
+def test_silent_controller_is_not_connected(tracks, roboteq):
+    assert tracks.spin_until(tracks.connected)
+    roboteq.device.silent = True
+    assert tracks.spin_until(lambda: not tracks.status[-1].connected)
+    roboteq.device.silent = False
+    assert tracks.spin_until(tracks.connected)
+
+
+def test_garbage_on_the_line_is_counted_and_survived(tracks, roboteq):
+    assert tracks.spin_until(tracks.connected)
+    for _ in range(5):
+        roboteq.device.send(b'\x00\xffA=zz\rQQ=1\r')
+    assert tracks.spin_until(lambda: tracks.node.monitor.parser.parse_errors >= 10)
+    assert tracks.spin_until(tracks.connected)
+
+
+def test_props_instance_publishes_props_status(roboteq):
+    with ros_node('probe_motor_props') as (probe, executor):
+        graph = Graph(probe, executor, str(roboteq.device.path), 'props')
+        try:
+            assert graph.spin_until(graph.connected)
+            status = graph.status[-1]
+            assert status.drive == DrivetrainStatus.DRIVE_PROPELLERS
+            assert status.port.speed_mps == 0.0
+            assert status.port.force_n == pytest.approx(133.0 * 0.60)
+        finally:
+            graph.node.destroy_node()
+
+
+def test_bad_drive_parameter_is_refused_with_its_name():
+    proc = NodeProcess('dukw_driver', 'motor_controller_node',
+                       ['--ros-args', '-p', 'drive:=rudder'])
+    proc.proc.wait(timeout=30)
+    code = proc.stop()
+    assert code == 2
+    assert "'drive'" in proc.stderr and 'Traceback' not in proc.stderr
