@@ -1,0 +1,139 @@
+"""Benchmark: the whole stack on the simulator at 100 Hz, as the main job runs it.
+
+Prints (no pass/fail):
+- latency from a sensor message to the actuator command it leads to, p50/p99/max;
+  target p99 <= 10 ms across processes;
+- each node's CPU share of one core from /proc/<pid>/stat (utime + stime over the
+  measuring window); target: the stack without the simulator <= 25 % of one core.
+
+Pairing (chain imu/data -> ekf_node -> odometry/filtered -> drive_controller_node ->
+tracks/cmd, props/cmd): an imu/data message with stamp S "leads to" the first
+tracks/cmd or props/cmd that this process receives after the first
+odometry/filtered whose stamp is >= S (the first estimate that can contain it).
+Latency = receive time of that command minus the sensor message's time. When the
+stamps are on the wall clock (sim without /clock), the sensor time is its stamp
+S; when the nodes run on the simulator's /clock (the main job's set-up), stamps
+are sim seconds, so the sensor time is the receive time of the imu/data message
+here, which leaves out its own delivery (~0.3 ms on this machine; the figure says
+which was used). Sensor messages no command followed within 100 ms count as lost.
+
+    python benchmarks/bench_stack.py [--duration 20] [--warmup 5]
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from dukw_bringup.bringup import Runner, load_stack, stack_path
+from dukw_bringup.mission import load_mission
+from dukw_bringup.run_setup import prepare_run
+from dukw_bringup.stack_metrics import cpu_seconds, pair_latencies
+from dukw_common.config import default_config_path
+
+class Probe:
+    """Receives the chain's topics and notes (receive time, stamp) of each message."""
+
+    def __init__(self, overlay: Path) -> None:
+        import rclpy
+        from dukw_msgs.msg import DiffCommand
+        from nav_msgs.msg import Odometry
+        from rclpy.context import Context
+        from rclpy.executors import SingleThreadedExecutor
+        from sensor_msgs.msg import Imu
+
+        from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS
+        self.context = Context()
+        rclpy.init(args=['--ros-args', '--params-file', str(overlay)], context=self.context)
+        self.node = rclpy.create_node('main_job', context=self.context)  # overlay: sim time
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        self.records: dict[str, list[tuple[float, float]]] = {
+            'imu': [], 'odom': [], 'cmd': []}
+        self.recording = False
+        for topic, cls, key, qos in (('imu/data', Imu, 'imu', SENSOR_QOS),
+                                     ('odometry/filtered', Odometry, 'odom', SENSOR_QOS),
+                                     ('tracks/cmd', DiffCommand, 'cmd', COMMAND_QOS),
+                                     ('props/cmd', DiffCommand, 'cmd', COMMAND_QOS)):
+            self.node.create_subscription(cls, topic, lambda m, k=key: self._on(k, m), qos)
+
+    def _on(self, key: str, msg) -> None:
+        if self.recording:
+            stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+            self.records[key].append((time.time(), stamp))
+
+    def spin(self, duration_s: float) -> None:
+        deadline = time.monotonic() + duration_s
+        while time.monotonic() < deadline:
+            self.executor.spin_once(timeout_sec=0.01)
+
+    def close(self) -> None:
+        import rclpy
+        self.executor.shutdown()
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+
+
+def main() -> int:
+    """Run the stack, measure, print."""
+    parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+    parser.add_argument('--duration', type=float, default=20.0, help='measuring window, s')
+    parser.add_argument('--warmup', type=float, default=5.0, help='s before measuring')
+    args = parser.parse_args()
+    run_dir = Path(tempfile.mkdtemp(prefix='bench_stack_'))
+    stack = load_stack(stack_path('sim'))
+    config, overlay = prepare_run(run_dir, default_config_path(), stack, load_mission(), 1.0)
+    runner = Runner(stack, [config, overlay], log_dir=run_dir / 'logs', echo=False)
+    runner.start()
+    probe = Probe(overlay)
+    try:
+        probe.spin(args.warmup)
+        pids = runner.pids()
+        cpu0 = {name: cpu_seconds(pid) for name, pid in pids.items()}
+        wall0 = time.monotonic()
+        probe.recording = True
+        probe.spin(args.duration)
+        probe.recording = False
+        wall = time.monotonic() - wall0
+        cpu = {name: cpu_seconds(pid) - cpu0[name] for name, pid in pids.items()}
+        dead = runner.poll()
+    finally:
+        probe.close()
+        runner.stop()
+    if dead is not None:
+        print(f'node {dead.spec.name} died during the benchmark; logs in {run_dir}/logs')
+        return 1
+    arrays = {k: np.array(v, dtype=float).reshape(-1, 2) for k, v in probe.records.items()}
+    print(f'stack on the simulator (real-time factor 1, 100 Hz), {wall:.1f} s measured; '
+          f'logs in {run_dir}/logs')
+    print('messages received: ' + ', '.join(f'{k} {len(v)}' for k, v in arrays.items()))
+    if min(len(v) for v in arrays.values()) == 0:
+        print('latency: not measured (a topic of the chain is silent)')
+    else:
+        delivery = arrays['imu'][:, 0] - arrays['imu'][:, 1]
+        use_stamps = bool(0.0 <= np.median(delivery) < 1.0)
+        latencies, lost = pair_latencies(arrays['imu'], arrays['odom'], arrays['cmd'],
+                                         use_stamps)
+        source = 'stamp (wall clock)' if use_stamps else 'receive time here (sim-time stamps)'
+        if len(latencies):
+            p50, p99 = np.percentile(latencies * 1e3, [50, 99])
+            print(f'latency imu/data -> tracks|props/cmd (sensor time = {source}): '
+                  f'p50 {p50:.2f} ms  p99 {p99:.2f} ms  max {latencies.max() * 1e3:.2f} ms  '
+                  f'n={len(latencies)} lost={lost}   target p99 <= 10 ms')
+        else:
+            print(f'latency: no pairs (lost={lost})')
+    print('CPU share of one core:')
+    for name, seconds in cpu.items():
+        print(f'  {name:<24} {100.0 * seconds / wall:6.1f} %')
+    without_sim = sum(s for n, s in cpu.items() if n != 'sim_node')
+    print(f'  {"stack without the sim":<24} {100.0 * without_sim / wall:6.1f} %'
+          '   target <= 25 %')
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
