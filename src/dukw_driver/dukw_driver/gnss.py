@@ -10,6 +10,8 @@ import math
 from dataclasses import dataclass
 from enum import Enum, IntEnum
 
+from dukw_common.config import ConfigError
+
 
 class FixStatus(IntEnum):
     """sensor_msgs/NavSatStatus status values."""
@@ -91,3 +93,28 @@ def velocity_from_course(speed_mps: float, course_deg: float, variance_mps2: flo
 def finite(*values: float) -> bool:
     """True when every value is a finite number."""
     return all(isinstance(v, (int, float)) and math.isfinite(v) for v in values)
+
+
+def parse_source(value: object, name: str) -> GnssSource:
+    """Parameter text -> GnssSource; ConfigError naming the parameter if it is neither."""
+    try:
+        return GnssSource(value)
+    except ValueError:
+        raise ConfigError(f'parameter {name!r} must be one of '
+                          f'{[s.value for s in GnssSource]}, got {value!r}') from None
+
+
+class SourcePreference:
+    """Take one receiver's data; fall back to the other only while the preferred one is silent."""
+
+    def __init__(self, preferred: GnssSource, fallback_after_s: float) -> None:
+        self.preferred = preferred
+        self.fallback_after_s = fallback_after_s
+        self._last_preferred_s = -math.inf
+
+    def accept(self, source: GnssSource, now_s: float) -> bool:
+        """True if data from ``source`` arriving at ``now_s`` should be published."""
+        if source == self.preferred:
+            self._last_preferred_s = now_s
+            return True
+        return now_s - self._last_preferred_s > self.fallback_after_s

@@ -115,6 +115,11 @@ class MavlinkCounters:
     by_type: dict[str, int] = field(default_factory=dict)
 
     @property
+    def messages(self) -> int:
+        """Good packets."""
+        return self.packets
+
+    @property
     def errors(self) -> int:
         """Frame plus value errors."""
         return self.frame_errors + self.parse_errors

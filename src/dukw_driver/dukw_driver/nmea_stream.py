@@ -40,6 +40,11 @@ class NmeaCounters:
     ignored: int = 0            # well-formed sentences of a type nobody asked for
 
     @property
+    def messages(self) -> int:
+        """Good sentences."""
+        return self.sentences
+
+    @property
     def errors(self) -> int:
         """Checksum plus parse errors."""
         return self.checksum_errors + self.parse_errors

@@ -1,4 +1,4 @@
-"""Numato Lab USB GPIO module with analog inputs (e.g. the 8-channel one): ASCII protocol. ROS-free.
+"""Numato Lab USB GPIO module with analog inputs (e.g. 8-channel): ASCII protocol. ROS-free.
 
 The module is a USB CDC serial device (``/dev/ttyACM*``; the baud rate is
 ignored). A command is ASCII ending in CR; the module echoes it and answers::
@@ -50,6 +50,16 @@ class AdcCounters:
     readings: int = 0
     parse_errors: int = 0    # lines that are neither an echo nor a value that follows one
     timeouts: int = 0        # requests never answered
+
+    @property
+    def messages(self) -> int:
+        """Good readings."""
+        return self.readings
+
+    @property
+    def errors(self) -> int:
+        """Parse errors plus timeouts."""
+        return self.parse_errors + self.timeouts
 
 
 class NumatoAdc:

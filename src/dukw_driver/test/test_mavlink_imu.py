@@ -72,7 +72,7 @@ def test_quaternion_and_euler_paths_agree(roll, pitch, yaw):
              cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
     via_quaternion = orientation_enu_flu_from_ned_frd(q_ned)
     via_euler = orientation_enu_flu_from_euler_ned(roll, pitch, yaw)
-    dot = abs(sum(a * b for a, b in zip(via_quaternion, via_euler)))
+    dot = abs(sum(a * b for a, b in zip(via_quaternion, via_euler, strict=True)))
     assert dot == pytest.approx(1.0, abs=1e-9)
 
 

@@ -111,3 +111,16 @@ def test_truncated_corrupted_and_random_input_never_raises(parts, noise):
         assert isinstance(item, (GpsFix, GpsVelocity))
     if damaged:
         assert dec.counters.errors >= 1
+
+
+def test_source_preference_falls_back_only_while_the_preferred_is_silent():
+    from dukw_common.config import ConfigError
+    from dukw_driver.gnss import GnssSource, SourcePreference, parse_source
+    pref = SourcePreference(GnssSource.NMEA, fallback_after_s=2.0)
+    assert pref.accept(GnssSource.MAVLINK, 0.0)          # nothing from the DGPS yet
+    assert pref.accept(GnssSource.NMEA, 1.0)
+    assert not pref.accept(GnssSource.MAVLINK, 2.5)
+    assert pref.accept(GnssSource.MAVLINK, 3.5)          # DGPS silent for 2.5 s
+    assert parse_source('mavlink', 'x') == GnssSource.MAVLINK
+    with pytest.raises(ConfigError, match='fix_source'):
+        parse_source('glonass', 'fix_source')

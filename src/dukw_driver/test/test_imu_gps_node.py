@@ -1,0 +1,170 @@
+"""imu_gps_node against a fake IMU (pymavlink on the far side) and a fake DGPS on ptys."""
+import math
+import time
+
+import pytest
+from diagnostic_msgs.msg import DiagnosticArray
+from geometry_msgs.msg import TwistWithCovarianceStamped
+from pymavlink.dialects.v20 import common as mavlink
+from sensor_msgs.msg import Imu, NavSatFix, NavSatStatus
+
+from dukw_common.config import ConfigError
+from dukw_common.geometry import euler_from_quaternion
+from dukw_common.node_tools import SENSOR_QOS, parameter_overrides
+from dukw_common.testing import ros_node, spin_until
+from dukw_driver.imu_gps_node import ImuGpsNode
+from dukw_driver.nmea_stream import nmea_sentence
+from fake_device import FakeDevice
+
+pytestmark = pytest.mark.ros
+
+
+class FakeImu:
+    """A GPS-aided IMU streaming MAVLink 2: heading north, turning to port, at rest on z."""
+
+    def __init__(self):
+        self.encoder = mavlink.MAVLink(None, srcSystem=1, srcComponent=1)
+
+    def stream(self):
+        msgs = [mavlink.MAVLink_scaled_imu_message(1, 0, 0, -1000, 0, 0, -200, 0, 0, 0),
+                mavlink.MAVLink_attitude_message(1, 0.0, 0.0, 0.0, 0.0, 0.0, -0.2),
+                mavlink.MAVLink_gps_raw_int_message(1, 3, 361836000, -757510000, 5000, 120,
+                                                    200, 0, 0, 10),
+                mavlink.MAVLink_global_position_int_message(1, 0, 0, 0, 0, 150, 0, 0, 0)]
+        return b''.join(m.pack(self.encoder) for m in msgs)
+
+
+def dgps_stream():
+    return (nmea_sentence('GPGST,120000.00,0.5,0.40,0.30,10.0,0.30,0.20,0.60')
+            + nmea_sentence('GPGGA,120000.00,3611.016,N,07545.060,W,2,09,0.9,2.0,M,-35.0,M,'
+                            '1.0,0042')
+            + nmea_sentence('GPVTG,000.0,T,,M,2.9,N,5.4,K,D'))
+
+
+class Graph:
+    """imu_gps_node plus a probe node subscribing to its topics."""
+
+    def __init__(self, probe, executor, **overrides):
+        self.executor = executor
+        self.node = ImuGpsNode(context=probe.context,
+                               parameter_overrides=parameter_overrides(overrides))
+        executor.add_node(self.node)
+        self.imu, self.fix, self.vel, self.diag = [], [], [], []
+        probe.create_subscription(Imu, 'imu/data', self.imu.append, SENSOR_QOS)
+        probe.create_subscription(NavSatFix, 'gps/fix', self.fix.append, SENSOR_QOS)
+        probe.create_subscription(TwistWithCovarianceStamped, 'gps/vel', self.vel.append,
+                                  SENSOR_QOS)
+        probe.create_subscription(DiagnosticArray, '/diagnostics', self.diag.append, 10)
+
+    def spin_until(self, predicate, timeout_s=5.0):
+        return spin_until(self.executor, predicate, timeout_s)
+
+    def status(self, device):
+        for array in reversed(self.diag):
+            for status in array.status:
+                if status.name.endswith(device):
+                    return status
+        return None
+
+    def close(self):
+        self.node.on_shutdown()
+        self.executor.remove_node(self.node)
+        self.node.destroy_node()
+
+
+@pytest.fixture
+def devices(tmp_path):
+    with FakeDevice(tmp_path / 'ttyImu', stream=FakeImu().stream, stream_period_s=0.02) as imu, \
+            FakeDevice(tmp_path / 'ttyDgps', stream=dgps_stream, stream_period_s=0.1) as dgps:
+        yield imu, dgps
+
+
+@pytest.fixture
+def graph(devices):
+    imu, dgps = devices
+    with ros_node('probe_imu_gps') as (probe, executor):
+        graph = Graph(probe, executor, **{'mavlink.port': str(imu.path),
+                                          'nmea.port': str(dgps.path)})
+        yield graph
+        graph.close()
+
+
+def test_publishes_imu_fix_and_velocity_in_ros_frames(graph):
+    def dgps_fix():
+        return [f for f in graph.fix if f.status.status == NavSatStatus.STATUS_GBAS_FIX]
+    assert graph.spin_until(lambda: graph.imu and dgps_fix() and graph.vel)
+    imu = graph.imu[-1]
+    assert imu.header.frame_id == 'imu_link'
+    _, _, yaw = euler_from_quaternion(imu.orientation.x, imu.orientation.y, imu.orientation.z,
+                                      imu.orientation.w)
+    assert yaw == pytest.approx(math.pi / 2, abs=1e-6)               # heading north
+    assert imu.angular_velocity.z == pytest.approx(0.2, abs=1e-6)    # turning to port
+    assert imu.linear_acceleration.z == pytest.approx(9.80665, abs=1e-4)
+    assert imu.linear_acceleration_covariance[0] == pytest.approx(0.010 ** 2)
+    assert imu.angular_velocity_covariance[4] == pytest.approx(math.radians(0.172) ** 2)
+    fix = dgps_fix()[-1]                                               # from the DGPS
+    assert fix.latitude == pytest.approx(36.1836) and fix.longitude == pytest.approx(-75.751)
+    assert fix.position_covariance_type == NavSatFix.COVARIANCE_TYPE_DIAGONAL_KNOWN
+    assert fix.position_covariance[0] == pytest.approx(0.04)          # east: longitude error
+    vel = graph.vel[-1]                                                # from the IMU's EKF
+    assert vel.header.frame_id == 'gps_link'
+    assert (vel.twist.twist.linear.x, vel.twist.twist.linear.y) == pytest.approx((0.0, 1.5))
+    assert graph.spin_until(lambda: graph.status('mavlink') and graph.status('nmea'))
+    assert graph.status('mavlink').level == b'\x00', graph.status('mavlink').message
+
+
+def test_unplugged_imu_is_an_error_and_publishes_again_after_replug(graph, devices):
+    imu_dev, _ = devices
+    assert graph.spin_until(lambda: graph.imu)
+    imu_dev.unplug()
+    assert graph.spin_until(lambda: (s := graph.status('mavlink')) is not None
+                            and s.level == b'\x02' and 'not connected' in s.message)
+    assert graph.fix, 'the DGPS keeps going while the IMU is away'
+    imu_dev.replug()
+    graph.imu.clear()
+    replugged = time.monotonic()
+    assert graph.spin_until(lambda: graph.imu, timeout_s=5.0)
+    assert time.monotonic() - replugged < 2.0, 'issue 4: publishing again within 2 s'
+    values = {kv.key: kv.value for kv in graph.status('mavlink').values}
+    assert graph.spin_until(lambda: {kv.key: kv.value for kv in graph.status(
+        'mavlink').values}['reconnects'] == '1'), values
+
+
+def test_garbage_on_the_line_is_counted_and_decoding_goes_on(graph, devices):
+    imu_dev, dgps_dev = devices
+    assert graph.spin_until(lambda: graph.imu and graph.fix)
+    dgps_dev.send(b'$GPGGA,garbage*00\r\n\x00\xff\xfe')
+    imu_dev.send(bytes(range(256)))
+
+    def errors(device):
+        status = graph.status(device)
+        return status is not None and int(
+            {kv.key: kv.value for kv in status.values}['parse_errors']) > 0
+    assert graph.spin_until(lambda: errors('nmea') and errors('mavlink')), [
+        (s.name, s.values) for s in graph.diag[-1].status]
+    graph.imu.clear()
+    graph.fix.clear()
+    assert graph.spin_until(lambda: graph.imu and graph.fix)
+
+
+def test_missing_port_starts_and_reports_error(tmp_path):
+    with ros_node('probe_imu_gps_missing') as (probe, executor):
+        graph = Graph(probe, executor, **{'mavlink.port': str(tmp_path / 'none0'),
+                                          'nmea.port': str(tmp_path / 'none1')})
+        try:
+            assert graph.spin_until(lambda: graph.status('nmea') is not None)
+            assert graph.status('nmea').level == b'\x02'
+            assert graph.status('mavlink').level == b'\x02'
+            assert not graph.imu
+        finally:
+            graph.close()
+
+
+@pytest.mark.parametrize('name,value', [('fix_source', 'galileo'), ('mavlink.baud', 12345),
+                                        ('nmea.port', ''), ('imu_frame_id', ''),
+                                        ('imu.gyro_std_dps', -1.0)])
+def test_bad_parameters_are_refused_naming_them(name, value):
+    with ros_node('probe_imu_gps_bad') as (probe, _):
+        with pytest.raises(ConfigError, match=name.replace('.', r'\.')):
+            ImuGpsNode(context=probe.context,
+                       parameter_overrides=parameter_overrides({name: value}))

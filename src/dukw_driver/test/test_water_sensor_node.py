@@ -1,0 +1,182 @@
+"""water_sensor_node against a fake Numato ADC module and a fake Airmar DT800 on ptys."""
+import math
+import re
+import threading
+import time
+
+import pytest
+from diagnostic_msgs.msg import DiagnosticArray
+from dukw_msgs.msg import Depth, WaterContact
+
+from dukw_common.config import ConfigError
+from dukw_common.node_tools import SENSOR_QOS, parameter_overrides
+from dukw_common.testing import ros_node, spin_until
+from dukw_driver.nmea_stream import nmea_sentence
+from dukw_driver.water_sensor_node import WaterSensorNode
+from fake_device import FakeDevice
+
+pytestmark = pytest.mark.ros
+
+
+class FakeNumato:
+    """The Numato module's ASCII protocol: echo 'adc read N', then the counts and a prompt."""
+
+    def __init__(self):
+        self.counts = {0: 20, 1: 20}
+        self.lock = threading.Lock()
+        self._buffer = b''
+
+    def respond(self, data):
+        self._buffer += data
+        out = b''
+        while b'\r' in self._buffer:
+            line, self._buffer = self._buffer.split(b'\r', 1)
+            match = re.fullmatch(rb'adc read (\d)', line.strip())
+            with self.lock:
+                value = self.counts.get(int(match.group(1))) if match else None
+            out += line + b'\n\r' + (b'%d\n\r' % value if value is not None else b'') + b'>'
+        return out
+
+
+class FakeSounder:
+    """An Airmar DT800 sending DPT and MTW once per period."""
+
+    def __init__(self):
+        self.depth = '2.40'
+
+    def stream(self):
+        return nmea_sentence(f'SDDPT,{self.depth},-0.25,') + nmea_sentence('YXMTW,17.5,C')
+
+
+class Graph:
+    """water_sensor_node plus a probe node subscribing to its topics."""
+
+    def __init__(self, probe, executor, **overrides):
+        self.executor = executor
+        self.node = WaterSensorNode(context=probe.context,
+                                    parameter_overrides=parameter_overrides(overrides))
+        executor.add_node(self.node)
+        self.contact, self.depth, self.diag = [], [], []
+        probe.create_subscription(WaterContact, 'water/contact', self.contact.append, SENSOR_QOS)
+        probe.create_subscription(Depth, 'depth', self.depth.append, SENSOR_QOS)
+        probe.create_subscription(DiagnosticArray, '/diagnostics', self.diag.append, 10)
+
+    def spin_until(self, predicate, timeout_s=5.0):
+        return spin_until(self.executor, predicate, timeout_s)
+
+    def status(self, device):
+        for array in reversed(self.diag):
+            for status in array.status:
+                if status.name.endswith(device):
+                    return status
+        return None
+
+    def close(self):
+        self.node.on_shutdown()
+        self.executor.remove_node(self.node)
+        self.node.destroy_node()
+
+
+@pytest.fixture
+def fakes(tmp_path):
+    numato, sounder = FakeNumato(), FakeSounder()
+    with FakeDevice(tmp_path / 'ttyAdc', respond=numato.respond) as adc_dev, \
+            FakeDevice(tmp_path / 'ttySounder', stream=sounder.stream,
+                       stream_period_s=0.1) as sounder_dev:
+        yield numato, adc_dev, sounder, sounder_dev
+
+
+@pytest.fixture
+def graph(fakes):
+    _, adc_dev, _, sounder_dev = fakes
+    with ros_node('probe_water') as (probe, executor):
+        graph = Graph(probe, executor, **{'adc.port': str(adc_dev.path),
+                                          'sounder.port': str(sounder_dev.path)})
+        yield graph
+        graph.close()
+
+
+def test_fore_goes_wet_after_the_debounce_and_aft_stays_dry(graph, fakes):
+    numato, adc_dev, _, _ = fakes
+    assert graph.spin_until(lambda: graph.contact)
+    first = graph.contact[-1]
+    assert not first.fore_wet and not first.aft_wet
+    assert first.fore_level == pytest.approx(20 / 1023)
+    assert first.header.frame_id == 'base_link'
+    assert adc_dev.wait_for(lambda sent: b'adc read 0\r' in sent and b'adc read 1\r' in sent)
+    with numato.lock:
+        numato.counts[0] = 900
+    assert graph.spin_until(lambda: graph.contact[-1].fore_level > 0.8)
+    wet_seen = time.monotonic()
+    assert not graph.contact[-1].fore_wet          # not before the 0.2 s debounce
+    assert graph.spin_until(lambda: graph.contact[-1].fore_wet)
+    assert time.monotonic() - wet_seen >= 0.1
+    assert not graph.contact[-1].aft_wet
+
+
+def test_depth_with_offset_and_temperature_then_too_shallow(graph, fakes):
+    _, _, sounder, _ = fakes
+    assert graph.spin_until(lambda: graph.depth and not math.isnan(graph.depth[-1].water_temp_c))
+    depth = graph.depth[-1]
+    assert depth.valid and depth.depth_m == pytest.approx(2.40)
+    assert depth.offset_m == pytest.approx(-0.25) and depth.water_temp_c == pytest.approx(17.5)
+    sounder.depth = '0.42'                          # under sensors.depth_sounder_min_m = 0.5
+    assert graph.spin_until(lambda: not graph.depth[-1].valid)
+    assert math.isnan(graph.depth[-1].depth_m)
+
+
+def test_unplugged_adc_is_an_error_and_publishes_again_after_replug(graph, fakes):
+    _, adc_dev, _, _ = fakes
+    assert graph.spin_until(lambda: graph.contact)
+    adc_dev.unplug()
+    assert graph.spin_until(lambda: (s := graph.status('adc')) is not None
+                            and s.level == b'\x02' and 'not connected' in s.message)
+    adc_dev.replug()
+    graph.contact.clear()
+    replugged = time.monotonic()
+    assert graph.spin_until(lambda: graph.contact, timeout_s=5.0)
+    assert time.monotonic() - replugged < 2.0, 'issue 4: publishing again within 2 s'
+    assert graph.depth, 'the sounder kept publishing while the ADC was away'
+
+
+def test_silent_adc_times_out_and_garbage_from_the_sounder_is_counted(graph, fakes):
+    _, adc_dev, _, sounder_dev = fakes
+    assert graph.spin_until(lambda: graph.contact and graph.depth)
+    adc_dev.silent = True
+    sounder_dev.send(b'$SDDPT,9.9,0.0*00\r\n\xff\xfe garbage\r\n')
+
+    def value(device, key):
+        status = graph.status(device)
+        return int({kv.key: kv.value for kv in status.values}[key]) if status else 0
+    assert graph.spin_until(lambda: value('adc', 'timeouts') > 0
+                            and value('sounder', 'parse_errors') >= 2)
+    assert graph.spin_until(lambda: graph.status('adc').level == b'\x02')  # stale_after_s
+    adc_dev.silent = False
+    graph.contact.clear()
+    assert graph.spin_until(lambda: graph.contact)
+
+
+def test_missing_ports_start_and_report_error(tmp_path):
+    with ros_node('probe_water_missing') as (probe, executor):
+        graph = Graph(probe, executor, **{'adc.port': str(tmp_path / 'none0'),
+                                          'sounder.port': str(tmp_path / 'none1')})
+        try:
+            assert graph.spin_until(lambda: graph.status('sounder') is not None)
+            assert graph.status('adc').level == b'\x02'
+            assert graph.status('sounder').level == b'\x02'
+        finally:
+            graph.close()
+
+
+@pytest.mark.parametrize('overrides,name', [
+    ({'adc.aft_channel': 0}, 'adc.aft_channel'),
+    ({'contact.wet_off_level': 0.9}, 'contact'),
+    ({'sounder.baud': 1234}, 'sounder.baud'),
+    ({'adc.port': ''}, 'adc.port'),
+    ({'adc.fore_channel': 12}, 'adc.fore_channel'),
+    ({'sensors.depth_sounder_min_m': -1.0}, 'sensors.depth_sounder_min_m')])
+def test_bad_parameters_are_refused_naming_them(overrides, name):
+    with ros_node('probe_water_bad') as (probe, _):
+        with pytest.raises(ConfigError, match=re.escape(name)):
+            WaterSensorNode(context=probe.context,
+                            parameter_overrides=parameter_overrides(overrides))
