@@ -119,8 +119,9 @@ class SimCore:
         self._stern_idx = (int(np.argmin(self.hull.station_x_m[:n // 2])),
                            n // 2 + int(np.argmin(self.hull.station_x_m[n // 2:])))
         self._external = (0.0, 0.0, 0.0)
-        self._water_key = None
-        self._water = None
+        self._hydro_key = None
+        self._hydro_val = None
+        self._wave_a2 = float(np.sum(self.world.waves.amplitude_m ** 2))
         self.reset()
 
     @classmethod
@@ -159,6 +160,20 @@ class SimCore:
         self.truth = self._compute_truth(Actuation(), None)
         return self.truth
 
+    def perturb(self, heave_m: float = 0.0, roll_rad: float = 0.0,
+                pitch_rad: float = 0.0) -> Truth:
+        """Displace a floating vehicle from where it is (a free-decay test); ValueError on land."""
+        for value in (heave_m, roll_rad, pitch_rad):
+            if not math.isfinite(value):
+                raise ValueError('perturbation must be finite')
+        if self.in_contact:
+            raise ValueError('perturb needs the vehicle afloat (tracks off the ground)')
+        self.z_cg += heave_m
+        self.roll += roll_rad
+        self.pitch += pitch_rad
+        self.truth = self._compute_truth(Actuation(), None)
+        return self.truth
+
     def set_external_force(self, fx_n: float = 0.0, fy_n: float = 0.0,
                            yaw_moment_nm: float = 0.0) -> None:
         """A horizontal force on the vehicle in odom (a tow line, a hand holding it), N."""
@@ -188,26 +203,29 @@ class SimCore:
                   + self.hull.station_y_m * math.sin(roll))
         return eta[:n] - bottom
 
-    def _sample_water(self):
-        key = (self.t_s, self.x, self.y, self.yaw, self.z_cg)
-        if self._water_key == key:
-            return self._water
+    def _hydro(self):
+        """Water at the sample points and the strips' immersion for the current pose (cached)."""
+        key = (self.t_s, self.x, self.y, self.yaw, self.z_cg, self.pitch, self.roll)
+        if self._hydro_key == key:
+            return self._hydro_val
         c, s = math.cos(self.yaw), math.sin(self.yaw)
         px = self.x + c * self._pts_x - s * self._pts_y
         py = self.y + s * self._pts_x + c * self._pts_y
-        pz = np.full(px.shape, self.z_cg + self.hull.axis_above_cg_m)
-        self._water_key = key
-        self._water = (px, self.world.sample(px, py, pz, self.t_s))
-        return self._water
+        water = self.world.sample(px, py, self.t_s, self._n_stations,
+                                  self.z_cg + self.hull.axis_above_cg_m)
+        depths = self._strip_depths(water.elevation_m, self.z_cg, self.pitch, self.roll)
+        areas = self.hull.areas_m2(depths)
+        self._hydro_key = key
+        self._hydro_val = (px, water, depths, areas)
+        return self._hydro_val
 
     def _grounded_buoyancy(self) -> float:
-        _, water = self._sample_water()
-        depths = self._strip_depths(water.elevation_m, self.z_cg, self.pitch, self.roll)
-        return self._rho_g * float(np.sum(self.hull.areas_m2(depths))) * self.hull.strip_length_m
+        areas = self._hydro()[3]
+        return self._rho_g * float(areas.sum()) * self.hull.strip_length_m
 
     def _float_height(self) -> float:
         """Centre-of-gravity height at which the level hull floats on the current surface."""
-        _, water = self._sample_water()
+        water = self._hydro()[1]
         lo, hi = -5.0, 5.0
         for _ in range(60):
             mid = 0.5 * (lo + hi)
@@ -232,15 +250,13 @@ class SimCore:
         c, s = math.cos(self.yaw), math.sin(self.yaw)
 
         # --- water at the strips and sample points
-        px, water = self._sample_water()
         n = self._n_stations
         gz, gpitch, groll, slope = self._ground_pose()
         if self.in_contact:
             self.z_cg, self.pitch, self.roll = gz + self._kg, gpitch, groll
-        depths = self._strip_depths(water.elevation_m, self.z_cg, self.pitch, self.roll)
-        areas = self.hull.areas_m2(depths)
+        px, water, depths, areas = self._hydro()
         strip_f = self._rho_g * self.hull.strip_length_m * areas
-        buoy = float(np.sum(strip_f))
+        buoy = float(strip_f.sum())
         volume = buoy / self._rho_g
         frac = min(volume / self._afloat_volume, 1.0)
 
@@ -260,15 +276,16 @@ class SimCore:
             wu = wv = 0.0
         else:
             vol_strip = areas * self.hull.strip_length_m
-            fwx = cm_rho * float(vol_strip @ water.accel_x_mps2[:n])
-            fwy = cm_rho * float(vol_strip @ water.accel_y_mps2[:n])
+            fwx = cm_rho * float(vol_strip @ water.accel_x_mps2)
+            fwy = cm_rho * float(vol_strip @ water.accel_y_mps2)
             drift = (p.waves.drift_force_coeff * 0.5 * self._rho_g
-                     * float(np.sum(self.world.waves.amplitude_m ** 2))
+                     * self._wave_a2
                      * veh.body.beam_m * frac)
             fwx -= drift                                    # shoreward, with the waves
             if volume > 1e-9:
-                wu = float(areas @ water.velocity_x_mps[:n]) / float(np.sum(areas))
-                wv = float(areas @ water.velocity_y_mps[:n]) / float(np.sum(areas))
+                area_sum = float(areas.sum())
+                wu = float(areas @ water.velocity_x_mps) / area_sum
+                wv = float(areas @ water.velocity_y_mps) / area_sum
             else:
                 wu = wv = 0.0
         # water velocity in body axes
@@ -285,7 +302,7 @@ class SimCore:
         alpha = min(dt / land.speed_loop_time_constant_s, 1.0)
         self.ref = [self.ref[i] + (targets[i] - self.ref[i]) * alpha for i in range(2)]
         ground = (u0 - r0 * self._half_sep, u0 + r0 * self._half_sep)
-        track_imm = min(max(float(np.mean(depths)) / (2.0 * self.hull.radius_m), 0.0), 1.0)
+        track_imm = min(max(float(depths.mean()) / self.seakeeping.equilibrium_depth_m, 0.0), 1.0)
         others = []
         paddle = []
         for i in range(2):
@@ -341,8 +358,8 @@ class SimCore:
                 Y += -s * down
         # water: propellers, drag, walk
         wat = p.water
-        stern_imm = [min(max(float(depths[k]) / (2.0 * self.hull.radius_m), 0.0), 1.0)
-                     for k in self._stern_idx]
+        d_float = self.seakeeping.equilibrium_depth_m
+        stern_imm = [min(max(float(depths[k]) / d_float, 0.0), 1.0) for k in self._stern_idx]
         thrust = [self._thrust(act.port_prop_pct) * stern_imm[0],
                   self._thrust(act.stbd_prop_pct) * stern_imm[1]]
         X += thrust[0] + thrust[1]
@@ -405,7 +422,7 @@ class SimCore:
         self.t_s += dt
         accel = ((self.u - u0) / dt - self.r * self.v, (self.v - v0) / dt + self.r * self.u,
                  (self.heave_vel - hv0) / dt)
-        self.truth = self._compute_truth(act, (tracks, thrust, w_eff, volume, fwx, fwy, accel))
+        self.truth = self._compute_truth(act, (tracks, thrust, w_eff, fwx, fwy, accel))
         return self.truth
 
     def _thrust(self, pct: float) -> float:
@@ -432,11 +449,10 @@ class SimCore:
         drive = veh.drivetrain
         sens = veh.sensors
         c, s = math.cos(self.yaw), math.sin(self.yaw)
-        px, water = self._sample_water()
+        px, water, depths, areas = self._hydro()
         n = self._n_stations
         eta = water.elevation_m
-        depths = self._strip_depths(eta, self.z_cg, self.pitch, self.roll)
-        volume = float(np.sum(self.hull.areas_m2(depths))) * self.hull.strip_length_m
+        volume = float(areas.sum()) * self.hull.strip_length_m
         beach = self.world.beach
         ground = beach.height_m(self.x)
         base_z = self.z_cg - self._kg
@@ -461,7 +477,7 @@ class SimCore:
             fwx = fwy = 0.0
             accel = (0.0, 0.0, 0.0)
         else:
-            tracks, thrust, w_eff, volume, fwx, fwy, accel = stepped
+            tracks, thrust, w_eff, fwx, fwy, accel = stepped
         g_up = self._g + accel[2]
         if tracks is not None:
             speeds, forces, motor, slips = (tracks.track_speed_mps, tracks.soil_force_n,

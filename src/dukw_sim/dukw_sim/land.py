@@ -49,7 +49,7 @@ def track_step(ref_mps: tuple, ground_mps: tuple, other_n: tuple, max_motor_n: f
     ``ref_mps`` are the speed loops' references, ``ground_mps`` the ground speeds under
     the tracks, ``other_n`` the motor's other loads (drivetrain friction, paddling).
     """
-    speeds, forces, motor, slips, derivs, sat = [], [], [], [], [], []
+    speeds, forces, motor, derivs, sat = [], [], [], [], []
     loaded = weight_per_track_n > 0.0
     if loaded:
         probe_t = np.array([ref_mps[0], ref_mps[0], ref_mps[1], ref_mps[1]])
@@ -82,7 +82,7 @@ def track_step(ref_mps: tuple, ground_mps: tuple, other_n: tuple, max_motor_n: f
         speeds.append(speed)
         forces.append(soil_n)
         motor.append(soil_n + other_n[i])
-        slips.append(float(traction.slip(speed, ground)))
         derivs.append(deriv)
         sat.append(saturated)
+    slips = traction.slip(np.array(speeds), np.array(ground_mps)).tolist()
     return TrackResult(speeds, forces, motor, slips, derivs, sat)

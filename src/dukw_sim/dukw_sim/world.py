@@ -204,6 +204,10 @@ class World:
         self.reference_depth_m = reference_depth_m
         self._height_scale = waves.height_scale_m if waves.count else 0.0
         self._k = np.hypot(waves.kx, waves.ky)
+        self._a_omega = waves.amplitude_m * waves.omega_rps
+        safe_k = np.where(self._k > 0.0, self._k, 1.0)
+        self._dir_x = waves.kx / safe_k          # unit travel direction of each component
+        self._dir_y = waves.ky / safe_k
 
     @property
     def calm(self) -> bool:
@@ -217,39 +221,44 @@ class World:
         cap = self.breaking_ratio * np.maximum(still_depth_m, 0.0) / self._height_scale
         return np.minimum(cap, 1.0)
 
-    def sample(self, x_m: np.ndarray, y_m: np.ndarray, z_m: np.ndarray,
-               t_s: float) -> WaterSample:
-        """Surface elevation and particle kinematics at points (x, y) and heights z, time t."""
+    def sample(self, x_m: np.ndarray, y_m: np.ndarray, t_s: float, kin_points: int = 0,
+               kin_height_m: float = 0.0) -> WaterSample:
+        """Surface elevation at points (x, y) at time t, and particle kinematics at the first
+        ``kin_points`` of them at height ``kin_height_m`` (odom z, clipped into the water).
+
+        The kinematics use one depth, the mean still-water depth of those points (a body a
+        few metres long on a gentle slope): the depth transfer is computed once per call.
+        """
         x = np.asarray(x_m, dtype=float)
         if self.calm:
             zero = np.zeros_like(x)
-            return WaterSample(zero, zero, zero, zero, zero)
+            kin = np.zeros(kin_points)
+            return WaterSample(zero, kin, kin, kin, kin)
         w = self.waves
         still = -self.beach.heights_m(x)
         factor = self.breaking_factor(still)
         phase = (np.multiply.outer(x, w.kx) + np.multiply.outer(np.asarray(y_m, float), w.ky)
-                 - w.omega_rps * t_s + w.phase_rad)
+                 + (w.phase_rad - w.omega_rps * t_s))
         cos_p = np.cos(phase)
-        sin_p = np.sin(phase)
         eta = factor * (cos_p @ w.amplitude_m)
-        depth = np.maximum(still, _MIN_KINEMATIC_DEPTH_M)
-        zc = np.clip(np.asarray(z_m, dtype=float), -depth, 0.0)
-        kh = np.multiply.outer(depth, self._k)
-        kz = np.multiply.outer(zc + depth, self._k)
-        transfer = np.cosh(kz) / np.sinh(kh)               # cosh k(z+h) / sinh kh
-        speed = transfer * (w.amplitude_m * w.omega_rps)   # |u| per component
-        along_x = w.kx / self._k
-        along_y = w.ky / self._k
-        vel = speed * cos_p
-        acc = speed * w.omega_rps * sin_p
-        return WaterSample(eta,
-                           factor * (vel @ along_x), factor * (vel @ along_y),
-                           factor * (acc @ along_x), factor * (acc @ along_y))
+        if kin_points <= 0:
+            kin = np.zeros(0)
+            return WaterSample(eta, kin, kin, kin, kin)
+        depth = max(float(still[:kin_points].mean()), _MIN_KINEMATIC_DEPTH_M)
+        zc = min(max(kin_height_m, -depth), 0.0)
+        transfer = np.cosh(self._k * (zc + depth)) / np.sinh(self._k * depth)
+        speed = transfer * self._a_omega
+        sin_p = np.sin(phase[:kin_points])
+        f = factor[:kin_points]
+        cos_k = cos_p[:kin_points]
+        accel = speed * w.omega_rps
+        return WaterSample(eta, f * (cos_k @ (speed * self._dir_x)),
+                           f * (cos_k @ (speed * self._dir_y)),
+                           f * (sin_p @ (accel * self._dir_x)), f * (sin_p @ (accel * self._dir_y)))
 
     def elevation_m(self, x_m: float, y_m: float, t_s: float) -> float:
         """Water surface above mean level at one point, m."""
-        return float(self.sample(np.array([x_m]), np.array([y_m]), np.array([0.0]),
-                                 t_s).elevation_m[0])
+        return float(self.sample(np.array([x_m]), np.array([y_m]), t_s).elevation_m[0])
 
     def water_depth_m(self, x_m: float, y_m: float, t_s: float) -> float:
         """Surface minus ground at one point, m (<= 0 on dry sand)."""

@@ -1,0 +1,165 @@
+"""SimCore: its API contract, determinism, bad input, and the Truth it fills."""
+import math
+from dataclasses import fields
+
+import numpy as np
+import pytest
+
+from dukw_common.config import ConfigError
+from dukw_estimation.buoyancy import hull_volume_from_depths
+from dukw_sim.core import Actuation, SimCore
+from dukw_sim.truth import Medium, Truth
+
+WAVES = {'waves.model': 'irregular', 'waves.significant_height_m': 0.28}
+
+
+def run(sim: SimCore, act: Actuation, steps: int) -> Truth:
+    for _ in range(steps):
+        truth = sim.step(act)
+    return truth
+
+
+def test_step_advances_dt_and_fills_every_field_finite():
+    sim = SimCore.from_config(overrides=WAVES, seed=2)
+    assert sim.dt_s == pytest.approx(0.01)
+    sim.reset('surf')
+    for _ in range(200):
+        truth = sim.step(Actuation(70, 66, 50, 50))
+        for f in fields(Truth):
+            value = getattr(truth, f.name)
+            assert math.isfinite(float(value)), f.name
+    assert truth.t_s == pytest.approx(2.0)
+    assert sim.truth is truth
+
+
+@pytest.mark.parametrize('bad', [Actuation(float('nan'), 0.0), Actuation(0.0, float('inf')),
+                                 Actuation(0, 0, float('-inf'), 0), Actuation(101.0, 0.0),
+                                 Actuation(0, 0, 0, -100.5)])
+def test_bad_actuation_raises_and_changes_nothing(bad):
+    sim = SimCore.from_config()
+    run(sim, Actuation(50, 50), 50)
+    before = sim.truth
+    state = (sim.t_s, sim.x, sim.u, list(sim.ref))
+    with pytest.raises(ValueError):
+        sim.step(bad)
+    assert sim.truth is before
+    assert (sim.t_s, sim.x, sim.u, list(sim.ref)) == state
+    with pytest.raises(ValueError):
+        sim.step((50, 50))
+
+
+def test_same_seed_same_run_other_seed_other_sea():
+    def trace(seed):
+        sim = SimCore.from_config(overrides=WAVES, seed=seed)
+        sim.reset('surf')
+        return [(t.x_m, t.z_m, t.port_force_n) for t in
+                (sim.step(Actuation(64, 64)) for _ in range(300))]
+    assert trace(7) == trace(7)
+    assert trace(7) != trace(8)
+
+
+def test_overrides_aliases_and_unknown_names():
+    sim = SimCore.from_config(overrides={'world.beach_slope_rad': 0.19})
+    assert sim.vehicle.site.beach_slope_rad == 0.19
+    assert sim.world.beach.slope_rad == 0.19
+    with pytest.raises(ConfigError):
+        SimCore.from_config(overrides={'world.no_such_thing': 1.0})
+    with pytest.raises(ConfigError):
+        SimCore.from_config(overrides={'waves.model': 'tsunami'})
+    with pytest.raises(ConfigError):
+        SimCore.from_config(overrides={'physics.dt_s': float('nan')})
+
+
+def test_reset_starts_on_sand_in_the_surf_and_afloat():
+    sim = SimCore.from_config()
+    sand = sim.reset('sand')
+    assert sand.medium == Medium.LAND and sand.in_ground_contact
+    assert sand.x_m == sim.params.start.sand_x_m
+    assert sand.effective_weight_n == pytest.approx(
+        sim.vehicle.body.displacement_n * math.cos(sim.vehicle.site.beach_slope_rad))
+    assert sand.water_depth_m < 0.0 and sand.fore_sensor_depth_m < 0.0
+    surf = sim.reset('surf')
+    assert surf.medium == Medium.TRANSITION
+    assert 0.0 < surf.effective_weight_n < sand.effective_weight_n
+    afloat = sim.reset('afloat', yaw_rad=1.0)
+    assert afloat.medium == Medium.WATER and not afloat.in_ground_contact
+    assert afloat.yaw_rad == 1.0
+    assert afloat.effective_weight_n == 0.0 and afloat.weight_on_tracks_fraction == 0.0
+    assert afloat.submerged_volume_m3 == pytest.approx(sim.vehicle.body.displaced_volume_m3,
+                                                       rel=1e-3)
+    assert afloat.fore_sensor_depth_m > 0.0 and afloat.aft_sensor_depth_m > 0.0
+    assert afloat.sounder_depth_m > 0.5
+    with pytest.raises(ValueError):
+        sim.reset('moon')
+    with pytest.raises(ValueError):
+        sim.reset(x_m=float('nan'))
+
+
+def test_submerged_volume_is_the_shared_strip_model():
+    sim = SimCore.from_config(overrides=WAVES, seed=1)
+    sim.reset('surf')
+    truth = run(sim, Actuation(30, 30), 150)
+    _, _, depths, _ = sim._hydro()
+    n = sim.hull.stations_per_hull
+    r, length = sim.vehicle.body.hull_radius_m, sim.vehicle.body.hull_length_m
+    expected = (hull_volume_from_depths(depths[:n], r, length)
+                + hull_volume_from_depths(depths[n:], r, length))
+    assert truth.submerged_volume_m3 == pytest.approx(expected)
+
+
+def test_imu_at_rest_reads_gravity_and_the_slope():
+    sim = SimCore.from_config()
+    sim.reset(x_m=-30.0)                                   # flat sand
+    truth = run(sim, Actuation(), 20)
+    assert truth.accel_z_mps2 == pytest.approx(9.81, abs=1e-6)
+    assert truth.accel_x_mps2 == pytest.approx(0.0, abs=1e-6)
+    sim.reset('sand')                                      # on the slope, bow to the sea
+    truth = run(sim, Actuation(), 5)
+    slope = sim.vehicle.site.beach_slope_rad
+    assert truth.pitch_rad == pytest.approx(slope, abs=1e-3)   # REP 103: nose down positive
+    assert truth.accel_x_mps2 == pytest.approx(-9.81 * math.sin(slope), abs=0.02)
+
+
+def test_motor_current_is_force_over_gain_plus_no_load():
+    sim = SimCore.from_config()
+    sim.reset(x_m=-30.0)
+    truth = run(sim, Actuation(50, 50), 300)
+    drive = sim.vehicle.drivetrain
+    motor_force = (truth.stbd_current_a - drive.no_load_current_a) \
+        * drive.track_force_gain_n_per_a
+    # the motor carries the soil force plus the drivetrain friction
+    assert motor_force == pytest.approx(truth.stbd_force_n + sim.params.land.drivetrain_friction_n,
+                                        rel=0.02)
+    assert truth.battery_voltage_v < drive.motor_voltage_v
+
+
+def test_start_up_force_peaks_above_the_running_force():
+    sim = SimCore.from_config()
+    sim.reset(x_m=-30.0)
+    forces = [sim.step(Actuation(64, 60)).stbd_force_n for _ in range(600)]
+    running = np.mean(forces[-100:])
+    assert running > 0.0
+    assert max(forces[:100]) > 1.8 * running
+
+
+def test_propellers_afloat_only_and_reverse_is_weaker():
+    sim = SimCore.from_config()
+    sim.reset(x_m=-30.0)
+    truth = run(sim, Actuation(0, 0, 100, 100), 100)
+    assert truth.port_thrust_n == 0.0 and truth.surge_mps == pytest.approx(0.0, abs=1e-3)
+    sim.reset('afloat')
+    fwd = run(sim, Actuation(0, 0, 100, 100), 10)
+    assert fwd.port_thrust_n == pytest.approx(sim.vehicle.drivetrain.max_prop_thrust_n)
+    rev = run(sim, Actuation(0, 0, -100, -100), 10)
+    assert -rev.port_thrust_n < fwd.port_thrust_n
+    assert rev.port_prop_current_a > 0.0
+
+
+def test_waves_lift_the_hull_off_the_sand_intermittently():
+    sim = SimCore.from_config(overrides=WAVES, seed=3)
+    sim.reset('sand')
+    truths = [sim.step(Actuation(64, 64)) for _ in range(2000)]
+    contact = np.array([t.in_ground_contact for t in truths], dtype=int)
+    assert np.count_nonzero(np.diff(contact)) >= 4            # touching, lifting, touching...
+    assert truths[0].medium == Medium.LAND and truths[-1].medium == Medium.WATER
+    assert min(t.effective_weight_n for t in truths) == 0.0
