@@ -38,13 +38,12 @@ class DepthReading:
 class DepthSounderDecoder:
     """Bytes from the sounder in, DepthReading out; never raises on bad input."""
 
-    SENTENCE_TYPES = ('DPT', 'DBT', 'MTW')
-
     def __init__(self, min_depth_m: float) -> None:
         if not finite(min_depth_m) or min_depth_m < 0:
             raise ValueError(f'min_depth_m must be a finite depth >= 0, got {min_depth_m!r}')
         self.min_depth_m = min_depth_m
-        self.stream = NmeaStream(self.SENTENCE_TYPES)
+        self._handlers = {'DPT': self._on_dpt, 'DBT': self._on_dbt, 'MTW': self._on_mtw}
+        self.stream = NmeaStream(self._handlers)
         self.counters = self.stream.counters
         self._offset_m = 0.0
         self._last_dpt_s = -math.inf
@@ -53,17 +52,7 @@ class DepthSounderDecoder:
 
     def feed(self, data: bytes, now_s: float) -> list[DepthReading]:
         """Decode received bytes at time ``now_s``."""
-        out = []
-        for sentence in self.stream.feed(data):
-            handler = getattr(self, f'_on_{sentence.sentence_type.lower()}')
-            try:
-                reading = handler(sentence, now_s)
-            except (ValueError, TypeError, AttributeError, ArithmeticError):
-                self.counters.parse_errors += 1
-                continue
-            if reading is not None:
-                out.append(reading)
-        return out
+        return self.stream.decode(data, now_s, self._handlers)
 
     def water_temp_c(self, now_s: float) -> float:
         """The last water temperature if recent, else NaN."""

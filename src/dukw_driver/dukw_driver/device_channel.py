@@ -12,7 +12,7 @@ from typing import Callable, Protocol
 
 from dukw_common.config import ConfigError
 from dukw_common.diagnostics import Health
-from dukw_driver.serial_link import DeviceHealth, SerialLink
+from dukw_driver.serial_link import DeviceHealth, SerialLink, validate_baud, validate_port
 
 
 class Counters(Protocol):
@@ -63,3 +63,9 @@ def require_name(value: object, name: str) -> str:
         raise ConfigError(f'parameter {name!r} must be a non-empty name without spaces, '
                           f'got {value!r}')
     return value
+
+
+def link_from_params(params: dict, device: str) -> SerialLink:
+    """A SerialLink on ``<device>.port`` at ``<device>.baud``; ConfigError naming a bad one."""
+    port = validate_port(params[f'{device}.port'], f'{device}.port')
+    return SerialLink(port, validate_baud(params[f'{device}.baud'], f'{device}.baud'))

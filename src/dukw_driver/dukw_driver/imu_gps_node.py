@@ -15,12 +15,12 @@ from sensor_msgs.msg import Imu, NavSatFix, NavSatStatus
 
 from dukw_common.node_tools import (SENSOR_QOS, ParamSpec, declare_parameters, diagnostic_array,
                                     run_node)
-from dukw_driver.device_channel import DeviceChannel, require_name
+from dukw_driver.device_channel import DeviceChannel, link_from_params, require_name
 from dukw_driver.gnss import (GpsFix, GpsVelocity, SourcePreference, UereSettings,
                               parse_source)
 from dukw_driver.mavlink_imu import ImuSample, ImuSettings, MavlinkImuDecoder
 from dukw_driver.nmea_gps import GpsNmeaDecoder, NmeaGpsSettings
-from dukw_driver.serial_link import DeviceHealth, SerialLink, validate_baud, validate_port
+from dukw_driver.serial_link import DeviceHealth
 
 STD = dict(min=0.0, max=100.0)
 PARAMS = [
@@ -78,10 +78,8 @@ class ImuGpsNode(Node):
 
     @staticmethod
     def _channel(p: dict, name: str, decoder) -> DeviceChannel:
-        port = validate_port(p[f'{name}.port'], f'{name}.port')
-        link = SerialLink(port, validate_baud(p[f'{name}.baud'], f'{name}.baud'))
         health = DeviceHealth(name, p['stale_after_s'], p[f'{name}.expected_rate_hz'])
-        return DeviceChannel(link, decoder.feed, decoder.counters, health)
+        return DeviceChannel(link_from_params(p, name), decoder.feed, decoder.counters, health)
 
     def _poll(self) -> None:
         now_s = time.monotonic()

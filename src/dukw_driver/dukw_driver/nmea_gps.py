@@ -38,11 +38,11 @@ class NmeaGpsSettings:
 class GpsNmeaDecoder:
     """Bytes from the DGPS in, GpsFix and GpsVelocity out; never raises on bad input."""
 
-    SENTENCE_TYPES = ('GGA', 'RMC', 'VTG', 'GST')
-
     def __init__(self, settings: NmeaGpsSettings) -> None:
         self.settings = settings
-        self.stream = NmeaStream(self.SENTENCE_TYPES)
+        self._handlers = {'GGA': self._on_gga, 'RMC': self._on_rmc, 'VTG': self._on_vtg,
+                          'GST': self._on_gst}
+        self.stream = NmeaStream(self._handlers)
         self.counters = self.stream.counters
         self._gst: tuple[float, float, float, float] | None = None  # lat, lon, alt std, time
         self._last_vtg_s = -math.inf
@@ -54,17 +54,7 @@ class GpsNmeaDecoder:
 
     def feed(self, data: bytes, now_s: float) -> list[GpsFix | GpsVelocity]:
         """Decode received bytes at time ``now_s``."""
-        out: list[GpsFix | GpsVelocity] = []
-        for sentence in self.stream.feed(data):
-            handler = getattr(self, f'_on_{sentence.sentence_type.lower()}')
-            try:
-                result = handler(sentence, now_s)
-            except (ValueError, TypeError, AttributeError, ArithmeticError):
-                self.counters.parse_errors += 1
-                continue
-            if result is not None:
-                out.append(result)
-        return out
+        return self.stream.decode(data, now_s, self._handlers)
 
     def _on_gga(self, gga, now_s: float) -> GpsFix:
         quality = gga.gps_qual

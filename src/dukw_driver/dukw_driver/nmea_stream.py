@@ -9,7 +9,7 @@ without one, or with a wrong one, is counted and dropped. Garbage before the
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Iterable
+from typing import Any, Callable, Iterable, Mapping
 
 import pynmea2
 
@@ -81,6 +81,24 @@ class NmeaStream:
         if len(self._buffer) > MAX_LINE_BYTES:  # no line end in sight: noise, drop it
             self.counters.parse_errors += 1
             self._buffer.clear()
+        return out
+
+    def decode(self, data: bytes, now_s: float,
+               handlers: Mapping[str, Callable[[Any, float], Any]]) -> list:
+        """Feed ``data`` and pass each sentence to ``handlers[type](sentence, now_s)``.
+
+        Returns the handlers' results that are not None. A handler that finds a field
+        unusable raises ValueError (or pynmea2's own field errors): counted, skipped.
+        """
+        out = []
+        for sentence in self.feed(data):
+            try:
+                result = handlers[sentence.sentence_type](sentence, now_s)
+            except (ValueError, TypeError, AttributeError, ArithmeticError):
+                self.counters.parse_errors += 1
+                continue
+            if result is not None:
+                out.append(result)
         return out
 
     def _parse_line(self, raw: bytes) -> pynmea2.NMEASentence | None:

@@ -16,9 +16,9 @@ from dukw_common.config import ConfigError
 from dukw_common.node_tools import (SENSOR_QOS, ParamSpec, declare_parameters, diagnostic_array,
                                     run_node)
 from dukw_driver.depth_sounder import DepthReading, DepthSounderDecoder
-from dukw_driver.device_channel import DeviceChannel, require_name
+from dukw_driver.device_channel import DeviceChannel, link_from_params, require_name
 from dukw_driver.numato_adc import MAX_CHANNEL, NumatoAdc
-from dukw_driver.serial_link import DeviceHealth, SerialLink, validate_baud, validate_port
+from dukw_driver.serial_link import DeviceHealth
 from dukw_driver.water_contact import ContactSettings, WaterContactDetector
 
 PARAMS = [
@@ -68,23 +68,18 @@ class WaterSensorNode(Node):
         self.detectors = {side: WaterContactDetector(contact) for side in ('fore', 'aft')}
         self._fresh: set[str] = set()
         sounder = DepthSounderDecoder(p['sensors.depth_sounder_min_m'])
-        self.adc_dev = DeviceChannel(self._link(p, 'adc'), lambda data, _t: self.adc.feed(data),
-                                     self.adc.counters, DeviceHealth(
-                                         'adc', p['stale_after_s'], 2.0 * p['rate_hz']))
-        self.sounder_dev = DeviceChannel(self._link(p, 'sounder'), sounder.feed,
-                                         sounder.counters, DeviceHealth(
-                                             'sounder', p['stale_after_s'],
-                                             p['sounder.expected_rate_hz']))
+        stale_s = p['stale_after_s']
+        self.adc_dev = DeviceChannel(
+            link_from_params(p, 'adc'), lambda data, _t: self.adc.feed(data), self.adc.counters,
+            DeviceHealth('adc', stale_s, expected_rate_hz=2.0 * p['rate_hz']))
+        self.sounder_dev = DeviceChannel(
+            link_from_params(p, 'sounder'), sounder.feed, sounder.counters,
+            DeviceHealth('sounder', stale_s, expected_rate_hz=p['sounder.expected_rate_hz']))
         self.contact_pub = self.create_publisher(WaterContact, 'water/contact', SENSOR_QOS)
         self.depth_pub = self.create_publisher(Depth, 'depth', SENSOR_QOS)
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self.create_timer(1.0 / p['rate_hz'], self._poll)
         self.create_timer(1.0, self._report)
-
-    @staticmethod
-    def _link(p: dict, name: str) -> SerialLink:
-        port = validate_port(p[f'{name}.port'], f'{name}.port')
-        return SerialLink(port, validate_baud(p[f'{name}.baud'], f'{name}.baud'))
 
     def _poll(self) -> None:
         now_s = time.monotonic()

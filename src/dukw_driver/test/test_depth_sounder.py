@@ -6,6 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from dukw_driver.depth_sounder import DepthReading, DepthSounderDecoder
+from damage import damaged_stream
 from dukw_driver.nmea_stream import nmea_sentence
 
 
@@ -68,15 +69,7 @@ SENTENCES = [nmea_sentence('SDDPT,2.40,-0.25,100'), nmea_sentence('SDDBT,7.9,f,2
                           st.booleans()), max_size=10), st.binary(max_size=40))
 def test_truncated_corrupted_and_random_input_never_raises(parts, noise):
     dec = DepthSounderDecoder(min_depth_m=0.5)
-    stream, damaged = b'', 0
-    for sentence, position, value, truncate in parts:
-        data = bytearray(sentence)
-        if truncate:
-            data = data[:1 + position % (len(data) - 3)] + b'\r\n'
-        else:
-            data[position % (len(data) - 2)] = value
-        damaged += bytes(data) != sentence
-        stream += bytes(data)
+    stream, damaged = damaged_stream(parts)
     for reading in dec.feed(noise + stream + b'\r\n', 0.0):
         assert reading.valid == (reading.depth_m >= 0.5)
         assert reading.valid or math.isnan(reading.depth_m)

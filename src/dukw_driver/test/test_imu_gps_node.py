@@ -3,18 +3,18 @@ import math
 import time
 
 import pytest
-from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import TwistWithCovarianceStamped
 from pymavlink.dialects.v20 import common as mavlink
 from sensor_msgs.msg import Imu, NavSatFix, NavSatStatus
 
 from dukw_common.config import ConfigError
 from dukw_common.geometry import euler_from_quaternion
-from dukw_common.node_tools import SENSOR_QOS, parameter_overrides
-from dukw_common.testing import ros_node, spin_until
+from dukw_common.node_tools import parameter_overrides
+from dukw_common.testing import ros_node
 from dukw_driver.imu_gps_node import ImuGpsNode
 from dukw_driver.nmea_stream import nmea_sentence
 from fake_device import FakeDevice
+from node_graph import NodeGraph
 
 pytestmark = pytest.mark.ros
 
@@ -41,35 +41,14 @@ def dgps_stream():
             + nmea_sentence('GPVTG,000.0,T,,M,2.9,N,5.4,K,D'))
 
 
-class Graph:
+class Graph(NodeGraph):
     """imu_gps_node plus a probe node subscribing to its topics."""
 
     def __init__(self, probe, executor, **overrides):
-        self.executor = executor
-        self.node = ImuGpsNode(context=probe.context,
-                               parameter_overrides=parameter_overrides(overrides))
-        executor.add_node(self.node)
-        self.imu, self.fix, self.vel, self.diag = [], [], [], []
-        probe.create_subscription(Imu, 'imu/data', self.imu.append, SENSOR_QOS)
-        probe.create_subscription(NavSatFix, 'gps/fix', self.fix.append, SENSOR_QOS)
-        probe.create_subscription(TwistWithCovarianceStamped, 'gps/vel', self.vel.append,
-                                  SENSOR_QOS)
-        probe.create_subscription(DiagnosticArray, '/diagnostics', self.diag.append, 10)
-
-    def spin_until(self, predicate, timeout_s=5.0):
-        return spin_until(self.executor, predicate, timeout_s)
-
-    def status(self, device):
-        for array in reversed(self.diag):
-            for status in array.status:
-                if status.name.endswith(device):
-                    return status
-        return None
-
-    def close(self):
-        self.node.on_shutdown()
-        self.executor.remove_node(self.node)
-        self.node.destroy_node()
+        super().__init__(probe, executor, ImuGpsNode, **overrides)
+        self.imu = self.record(Imu, 'imu/data')
+        self.fix = self.record(NavSatFix, 'gps/fix')
+        self.vel = self.record(TwistWithCovarianceStamped, 'gps/vel')
 
 
 @pytest.fixture
@@ -125,9 +104,7 @@ def test_unplugged_imu_is_an_error_and_publishes_again_after_replug(graph, devic
     replugged = time.monotonic()
     assert graph.spin_until(lambda: graph.imu, timeout_s=5.0)
     assert time.monotonic() - replugged < 2.0, 'issue 4: publishing again within 2 s'
-    values = {kv.key: kv.value for kv in graph.status('mavlink').values}
-    assert graph.spin_until(lambda: {kv.key: kv.value for kv in graph.status(
-        'mavlink').values}['reconnects'] == '1'), values
+    assert graph.spin_until(lambda: graph.value('mavlink', 'reconnects') == '1')
 
 
 def test_garbage_on_the_line_is_counted_and_decoding_goes_on(graph, devices):
@@ -136,12 +113,8 @@ def test_garbage_on_the_line_is_counted_and_decoding_goes_on(graph, devices):
     dgps_dev.send(b'$GPGGA,garbage*00\r\n\x00\xff\xfe')
     imu_dev.send(bytes(range(256)))
 
-    def errors(device):
-        status = graph.status(device)
-        return status is not None and int(
-            {kv.key: kv.value for kv in status.values}['parse_errors']) > 0
-    assert graph.spin_until(lambda: errors('nmea') and errors('mavlink')), [
-        (s.name, s.values) for s in graph.diag[-1].status]
+    assert graph.spin_until(lambda: int(graph.value('nmea', 'parse_errors', 0)) > 0
+                            and int(graph.value('mavlink', 'parse_errors', 0)) > 0)
     graph.imu.clear()
     graph.fix.clear()
     assert graph.spin_until(lambda: graph.imu and graph.fix)

@@ -7,6 +7,7 @@ from hypothesis import strategies as st
 
 from dukw_driver.gnss import CovarianceKind, FixStatus, GpsFix, GpsVelocity, UereSettings
 from dukw_driver.nmea_gps import GpsNmeaDecoder, NmeaGpsSettings
+from damage import damaged_stream
 from dukw_driver.nmea_stream import nmea_sentence
 
 SETTINGS = NmeaGpsSettings(UereSettings(autonomous_m=4.0, differential_m=0.7),
@@ -97,15 +98,7 @@ SENTENCES = [gga(), GST, nmea_sentence('GPVTG,054.7,T,034.4,M,005.5,N,010.2,K,D'
                           st.booleans()), max_size=10), st.binary(max_size=40))
 def test_truncated_corrupted_and_random_input_never_raises(parts, noise):
     dec = GpsNmeaDecoder(SETTINGS)
-    stream, damaged = b'', 0
-    for sentence, position, value, truncate in parts:
-        data = bytearray(sentence)
-        if truncate:
-            data = data[:1 + position % (len(data) - 3)] + b'\r\n'
-        else:
-            data[position % (len(data) - 2)] = value
-        damaged += bytes(data) != sentence
-        stream += bytes(data)
+    stream, damaged = damaged_stream(parts)
     out = dec.feed(stream + noise + b'\r\n', 0.0)
     for item in out:
         assert isinstance(item, (GpsFix, GpsVelocity))

@@ -5,15 +5,15 @@ import threading
 import time
 
 import pytest
-from diagnostic_msgs.msg import DiagnosticArray
 from dukw_msgs.msg import Depth, WaterContact
 
 from dukw_common.config import ConfigError
-from dukw_common.node_tools import SENSOR_QOS, parameter_overrides
-from dukw_common.testing import ros_node, spin_until
+from dukw_common.node_tools import parameter_overrides
+from dukw_common.testing import ros_node
 from dukw_driver.nmea_stream import nmea_sentence
 from dukw_driver.water_sensor_node import WaterSensorNode
 from fake_device import FakeDevice
+from node_graph import NodeGraph
 
 pytestmark = pytest.mark.ros
 
@@ -48,33 +48,13 @@ class FakeSounder:
         return nmea_sentence(f'SDDPT,{self.depth},-0.25,') + nmea_sentence('YXMTW,17.5,C')
 
 
-class Graph:
+class Graph(NodeGraph):
     """water_sensor_node plus a probe node subscribing to its topics."""
 
     def __init__(self, probe, executor, **overrides):
-        self.executor = executor
-        self.node = WaterSensorNode(context=probe.context,
-                                    parameter_overrides=parameter_overrides(overrides))
-        executor.add_node(self.node)
-        self.contact, self.depth, self.diag = [], [], []
-        probe.create_subscription(WaterContact, 'water/contact', self.contact.append, SENSOR_QOS)
-        probe.create_subscription(Depth, 'depth', self.depth.append, SENSOR_QOS)
-        probe.create_subscription(DiagnosticArray, '/diagnostics', self.diag.append, 10)
-
-    def spin_until(self, predicate, timeout_s=5.0):
-        return spin_until(self.executor, predicate, timeout_s)
-
-    def status(self, device):
-        for array in reversed(self.diag):
-            for status in array.status:
-                if status.name.endswith(device):
-                    return status
-        return None
-
-    def close(self):
-        self.node.on_shutdown()
-        self.executor.remove_node(self.node)
-        self.node.destroy_node()
+        super().__init__(probe, executor, WaterSensorNode, **overrides)
+        self.contact = self.record(WaterContact, 'water/contact')
+        self.depth = self.record(Depth, 'depth')
 
 
 @pytest.fixture
@@ -144,12 +124,8 @@ def test_silent_adc_times_out_and_garbage_from_the_sounder_is_counted(graph, fak
     assert graph.spin_until(lambda: graph.contact and graph.depth)
     adc_dev.silent = True
     sounder_dev.send(b'$SDDPT,9.9,0.0*00\r\n\xff\xfe garbage\r\n')
-
-    def value(device, key):
-        status = graph.status(device)
-        return int({kv.key: kv.value for kv in status.values}[key]) if status else 0
-    assert graph.spin_until(lambda: value('adc', 'timeouts') > 0
-                            and value('sounder', 'parse_errors') >= 2)
+    assert graph.spin_until(lambda: int(graph.value('adc', 'timeouts', 0)) > 0
+                            and int(graph.value('sounder', 'parse_errors', 0)) >= 2)
     assert graph.spin_until(lambda: graph.status('adc').level == b'\x02')  # stale_after_s
     adc_dev.silent = False
     graph.contact.clear()
