@@ -84,3 +84,68 @@ def afloat_volume_m3(displacement_n: float, water_density_kgpm3: float,
                      gravity_mps2: float) -> float:
     """Displaced volume when afloat: Delta / (rho g), m^3."""
     return displacement_n / (water_density_kgpm3 * gravity_mps2)
+
+
+def _wedge_volume(depth_m: float, gradient: float, radius_m: float) -> float:
+    """Volume of a semi-infinite hull whose bottom line dips linearly under the surface.
+
+    ``depth_m`` is the water depth (normal to the hull axis) over the bottom at the deep
+    end, ``gradient`` the depth gained per metre along the hull (tan of the paper's theta).
+    """
+    if depth_m <= 0.0:
+        return 0.0
+    return float(hull_volume_on_slope(depth_m / gradient, math.atan(gradient), radius_m))
+
+
+def submerged_length_m(waterline_distance_m: float, slope_rad: float, hull_clearance_m: float,
+                       bow_x_m: float, stern_x_m: float, surface_m: float = 0.0,
+                       heading_cos: float = 1.0) -> float:
+    """h2: submerged length along the hull bottom from base_link's waterline distance, m.
+
+    base_link (centre of the track contact, on the ground) lies ``waterline_distance_m``
+    seaward of the mean waterline, measured along a beach of slope ``slope_rad``; the hull
+    bottom runs from ``stern_x_m`` to ``bow_x_m`` (base_link x), ``hull_clearance_m`` above
+    the ground. ``surface_m`` lifts the water surface (a wave) above the mean level;
+    ``heading_cos`` is cos(yaw - seaward direction): 1 bow to the sea, -1 stern to the sea.
+    The result is clipped to [0, bow - stern].
+    """
+    depth0, gradient = _bottom_depth_line(waterline_distance_m, slope_rad, hull_clearance_m,
+                                          surface_m, heading_cos)
+    length = bow_x_m - stern_x_m
+    if abs(gradient) < 1e-9:
+        return length if depth0 > 0.0 else 0.0
+    deep_x = bow_x_m if gradient > 0.0 else stern_x_m
+    deep = depth0 + gradient * deep_x
+    return float(min(max(deep / abs(gradient), 0.0), length))
+
+
+def _bottom_depth_line(waterline_distance_m: float, slope_rad: float, hull_clearance_m: float,
+                       surface_m: float, heading_cos: float) -> tuple[float, float]:
+    """Water depth over the hull bottom (normal to the hull) at base_link x = 0, and its
+    gradient per metre of body x, for a vehicle lying on the slope."""
+    cos_t = math.cos(slope_rad)
+    depth_at_origin = (surface_m + waterline_distance_m * math.sin(slope_rad)) / cos_t \
+        - hull_clearance_m
+    return depth_at_origin, heading_cos * math.tan(slope_rad)
+
+
+def grounded_volume_m3(waterline_distance_m: float, slope_rad: float, hull_clearance_m: float,
+                       bow_x_m: float, stern_x_m: float, radius_m: float,
+                       surface_m: float = 0.0, heading_cos: float = 1.0) -> float:
+    """Submerged volume of BOTH hulls of a vehicle standing on the slope, m^3.
+
+    Each hull is a cylinder of ``radius_m`` from ``stern_x_m`` to ``bow_x_m`` (vehicle.md
+    section 6): the paper's wedge volume for the deep end minus the one beyond the shallow
+    end, so a hull wholly under water with its shallow end wet is exact too. Not capped at
+    the displacement: compare with ``afloat_volume_m3`` to know whether the vehicle floats.
+    """
+    depth0, gradient = _bottom_depth_line(waterline_distance_m, slope_rad, hull_clearance_m,
+                                          surface_m, heading_cos)
+    length = bow_x_m - stern_x_m
+    if abs(gradient) < 1e-6:
+        return 2.0 * float(segment_area_m2(depth0, radius_m)) * length
+    deep_x, shallow_x = (bow_x_m, stern_x_m) if gradient > 0.0 else (stern_x_m, bow_x_m)
+    g = abs(gradient)
+    one = _wedge_volume(depth0 + gradient * deep_x, g, radius_m) \
+        - _wedge_volume(depth0 + gradient * shallow_x, g, radius_m)
+    return 2.0 * one

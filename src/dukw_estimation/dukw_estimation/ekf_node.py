@@ -1,17 +1,88 @@
-"""ekf_node: skeleton (filled in by its own issue)."""
-from rclpy.node import Node
+"""ekf_node: fuses IMU, DGPS, water contact, depth and motor status into odometry and traction.
 
-from dukw_common.node_tools import ParamSpec, declare_parameters, run_node
+Subscribes (sensor QoS) imu/data, gps/fix, gps/vel, water/contact, depth, tracks/status,
+props/status; publishes odometry/filtered (odom -> base_link), traction and /diagnostics;
+serves set_pose (dukw_msgs/srv/SetPose). All the work is in dukw_estimation.estimator.
+"""
+from __future__ import annotations
+
+from diagnostic_msgs.msg import DiagnosticArray
+from dukw_msgs.msg import Depth, DrivetrainStatus, Traction, WaterContact
+from dukw_msgs.srv import SetPose
+from geometry_msgs.msg import TwistWithCovarianceStamped
+from nav_msgs.msg import Odometry
+from rclpy.node import Node
+from sensor_msgs.msg import Imu, NavSatFix
+
+from dukw_common.config import node_params, section
+from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, ParamSpec, declare_parameters,
+                                    diagnostic_array, run_node, s_to_stamp, vehicle_specs)
+from dukw_common.vehicle import Vehicle, soil_params
+from dukw_estimation import ros_convert as conv
+from dukw_estimation.estimator import Estimator
+from dukw_estimation.settings import EkfSettings, setting_specs
+
+DIAGNOSTICS_PERIOD_S = 1.0
 
 
 class EkfNode(Node):
-    """Skeleton: declares its parameters from config/ and idles."""
+    """Thin shell around Estimator: messages in, estimates out at rate_hz."""
 
-    def __init__(self) -> None:
-        super().__init__('ekf_node')
-        self.params = declare_parameters(self, [
-            ParamSpec('rate_hz', 'main loop rate, Hz', min=0.1, max=1000.0),
-        ])
+    def __init__(self, **node_kwargs) -> None:
+        super().__init__('ekf_node', **node_kwargs)
+        specs = [ParamSpec(n, d, min=lo, max=hi) for n, d, lo, hi in setting_specs()]
+        specs += vehicle_specs()
+        specs += [ParamSpec(f'soil_presets.{name}', 'soil preset value (vehicle.md 6)', min=0.0)
+                  for name in section(node_params('ekf_node'), 'soil_presets')
+                  if name != 'names']
+        params = declare_parameters(self, specs)
+        self.settings = EkfSettings.from_params(params)
+        soil = soil_params(params, self.settings.soil_preset or None)
+        self.estimator = Estimator(Vehicle.from_params(params), self.settings, soil)
+        self.odom_pub = self.create_publisher(Odometry, 'odometry/filtered', COMMAND_QOS)
+        self.traction_pub = self.create_publisher(Traction, 'traction', COMMAND_QOS)
+        self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
+        est = self.estimator
+        for msg_type, topic, convert, add in (
+                (Imu, 'imu/data', conv.imu_sample, est.add_imu),
+                (NavSatFix, 'gps/fix', conv.gps_fix, est.add_gps_fix),
+                (TwistWithCovarianceStamped, 'gps/vel', conv.gps_velocity,
+                 est.add_gps_velocity),
+                (WaterContact, 'water/contact', conv.water_contact, est.add_water_contact),
+                (Depth, 'depth', conv.depth, est.add_depth),
+                (DrivetrainStatus, 'tracks/status', conv.drive_status, est.add_tracks),
+                (DrivetrainStatus, 'props/status', conv.drive_status, est.add_props)):
+            self.create_subscription(msg_type, topic, self._handler(convert, add), SENSOR_QOS)
+        self.create_service(SetPose, 'set_pose', self._on_set_pose)
+        self.create_timer(1.0 / self.settings.rate_hz, self._on_timer)
+        self.create_timer(DIAGNOSTICS_PERIOD_S, self._on_diagnostics)
+
+    def _now_s(self) -> float:
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def _handler(self, convert, add):
+        def callback(msg) -> None:
+            add(convert(msg, conv.stamp_or(msg, self._now_s())))
+        return callback
+
+    def _on_timer(self) -> None:
+        est = self.estimator
+        if est.t_s is None:
+            return  # nothing measured yet
+        now = self._now_s()
+        if 0.0 < now - est.t_s <= self.settings.sensor_timeout_s:
+            est.advance(now)  # predict to the present, never further than a timeout
+        stamp = s_to_stamp(est.t_s)
+        self.odom_pub.publish(conv.odometry_msg(est.odometry(), stamp, 'odom', 'base_link'))
+        self.traction_pub.publish(conv.traction_msg(est.traction(), stamp, Traction))
+
+    def _on_diagnostics(self) -> None:
+        self.diag_pub.publish(diagnostic_array(self, self.estimator.health(self._now_s())))
+
+    def _on_set_pose(self, request, response):
+        response.success = self.estimator.set_pose(request.x_m, request.y_m, request.yaw_rad)
+        response.message = 'pose set' if response.success else 'refused: non-finite pose'
+        return response
 
 
 def main(args=None) -> int:

@@ -1,0 +1,189 @@
+"""The motion filter: a 10-state EKF in the plane, with the waterline distance and the wave.
+
+State (``Idx``): odom position x, y; yaw; body surge u, sway v; yaw rate r; gyro-z bias;
+waterline distance s (along the slope, base_link seaward of the mean waterline); wave
+elevation eta at the vehicle and its rate (a noise-driven damped oscillator at the sea's
+peak frequency).
+
+Predict and update are written with numpy directly rather than through filterpy's
+generic ``ExtendedKalmanFilter``: its update cannot gate an innovation before applying it
+and copies the state several times per call; this keeps one predict + update well under
+100 us (benchmarks/bench_ekf.py). The track-force smoother does use filterpy.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import Enum, IntEnum
+
+import numpy as np
+
+from dukw_common.geometry import wrap_angle
+
+
+class Idx(IntEnum):
+    """Positions in the state vector."""
+
+    X = 0
+    Y = 1
+    YAW = 2
+    U = 3
+    V = 4
+    R = 5
+    BIAS = 6
+    S = 7
+    ETA = 8
+    ETA_RATE = 9
+
+
+N_STATES = len(Idx)
+
+
+class Outcome(Enum):
+    """What became of one measurement."""
+
+    ACCEPTED = 'accepted'
+    REJECTED_NAN = 'rejected_nan'
+    REJECTED_OUT_OF_ORDER = 'rejected_out_of_order'
+    REJECTED_OUTLIER = 'rejected_outlier'
+    IGNORED = 'ignored'          # disabled sensor, no fix, nothing to learn
+
+
+@dataclass
+class ProcessNoise:
+    """Continuous-time process noise densities (sigma per sqrt(s)) and the wave model."""
+
+    position_m: float
+    yaw_rad: float
+    accel_mps2: float
+    yaw_accel_rps2: float
+    gyro_bias_rps: float
+    waterline_m: float
+    wave_omega_rps: float
+    wave_damping: float
+    wave_sigma_m: float
+
+    def wave_drive(self) -> float:
+        """Spectral density driving the oscillator so that its stationary sigma is wave_sigma."""
+        w = self.wave_omega_rps
+        return 4.0 * self.wave_damping * w ** 3 * self.wave_sigma_m ** 2
+
+
+class MotionEkf:
+    """Planar EKF with gated updates. Angles in rad, SI units, odom ENU."""
+
+    def __init__(self, x0: np.ndarray, p0_diag: np.ndarray, noise: ProcessNoise,
+                 seaward_yaw_rad: float) -> None:
+        self.x = np.asarray(x0, dtype=float).copy()
+        self.P = np.diag(np.asarray(p0_diag, dtype=float))
+        self.noise = noise
+        self.seaward_yaw_rad = seaward_yaw_rad
+        self._eye = np.eye(N_STATES)
+
+    def predict(self, dt: float, accel_body: tuple[float, float] | None = None,
+                drive_target: tuple[float, float, float] | None = None,
+                accel_noise_mps2: float | None = None, slope_rad: float = 0.0) -> None:
+        """Advance by ``dt`` s.
+
+        ``accel_body``: (du/dt, dv/dt) from the IMU (gravity and centripetal removed) as
+        input. Else ``drive_target`` (u, r, time constant) pulls u and r towards what the
+        tracks or propellers command; else u, v, r are held (random walk).
+        """
+        if dt <= 0.0:
+            return
+        x = self.x
+        yaw, u, v, r = x[Idx.YAW], x[Idx.U], x[Idx.V], x[Idx.R]
+        c, s = math.cos(yaw), math.sin(yaw)
+        rel = yaw - self.seaward_yaw_rad
+        cr, sr = math.cos(rel), math.sin(rel)
+        inv_cos = 1.0 / math.cos(slope_rad)
+        F = self._eye.copy()
+        x[Idx.X] += (u * c - v * s) * dt
+        x[Idx.Y] += (u * s + v * c) * dt
+        F[Idx.X, Idx.YAW] = (-u * s - v * c) * dt
+        F[Idx.X, Idx.U] = c * dt
+        F[Idx.X, Idx.V] = -s * dt
+        F[Idx.Y, Idx.YAW] = (u * c - v * s) * dt
+        F[Idx.Y, Idx.U] = s * dt
+        F[Idx.Y, Idx.V] = c * dt
+        x[Idx.S] += (u * cr - v * sr) * inv_cos * dt
+        F[Idx.S, Idx.YAW] = (-u * sr - v * cr) * inv_cos * dt
+        F[Idx.S, Idx.U] = cr * inv_cos * dt
+        F[Idx.S, Idx.V] = -sr * inv_cos * dt
+        x[Idx.YAW] = wrap_angle(yaw + r * dt)
+        F[Idx.YAW, Idx.R] = dt
+        if accel_body is not None:
+            x[Idx.U] += accel_body[0] * dt
+            x[Idx.V] += accel_body[1] * dt
+        elif drive_target is not None:
+            u_t, r_t, tau = drive_target
+            k = min(dt / tau, 1.0)
+            x[Idx.U] += (u_t - u) * k
+            x[Idx.V] -= v * k
+            x[Idx.R] += (r_t - r) * k
+            F[Idx.U, Idx.U] = F[Idx.V, Idx.V] = F[Idx.R, Idx.R] = 1.0 - k
+        n = self.noise
+        w, z = n.wave_omega_rps, n.wave_damping
+        eta, eta_rate = x[Idx.ETA], x[Idx.ETA_RATE]
+        x[Idx.ETA] = eta + eta_rate * dt
+        x[Idx.ETA_RATE] = eta_rate + (-w * w * eta - 2.0 * z * w * eta_rate) * dt
+        F[Idx.ETA, Idx.ETA_RATE] = dt
+        F[Idx.ETA_RATE, Idx.ETA] = -w * w * dt
+        F[Idx.ETA_RATE, Idx.ETA_RATE] = 1.0 - 2.0 * z * w * dt
+        accel = n.accel_mps2 if accel_noise_mps2 is None else accel_noise_mps2
+        q = np.array([n.position_m ** 2, n.position_m ** 2, n.yaw_rad ** 2, accel ** 2,
+                      accel ** 2, n.yaw_accel_rps2 ** 2, n.gyro_bias_rps ** 2,
+                      n.waterline_m ** 2, 0.0, n.wave_drive()]) * dt
+        P = F @ self.P @ F.T
+        P[np.diag_indices(N_STATES)] += q
+        self.P = P
+
+    def update(self, z: np.ndarray, hx: np.ndarray, H: np.ndarray, R: np.ndarray,
+               gate: float, angle_rows: tuple[int, ...] = ()) -> Outcome:
+        """Gated EKF update (Joseph form). Rejects when the Mahalanobis distance > ``gate``."""
+        y = np.asarray(z, dtype=float) - hx
+        for row in angle_rows:
+            y[row] = wrap_angle(y[row])
+        PHt = self.P @ H.T
+        S = H @ PHt + R
+        try:
+            S_inv = np.linalg.inv(S)
+        except np.linalg.LinAlgError:
+            return Outcome.REJECTED_OUTLIER
+        d2 = float(y @ S_inv @ y)
+        if not math.isfinite(d2) or d2 > gate * gate:
+            return Outcome.REJECTED_OUTLIER
+        K = PHt @ S_inv
+        self.x += K @ y
+        self.x[Idx.YAW] = wrap_angle(self.x[Idx.YAW])
+        I_KH = self._eye - K @ H
+        self.P = I_KH @ self.P @ I_KH.T + K @ R @ K.T
+        return Outcome.ACCEPTED
+
+    def update_scalar(self, z: float, hx: float, h: np.ndarray, var: float,
+                      gate: float, angle: bool = False) -> Outcome:
+        """Gated update with one scalar measurement; ``h`` is the Jacobian row."""
+        y = z - hx
+        if angle:
+            y = wrap_angle(y)
+        Ph = self.P @ h
+        s = float(h @ Ph) + var
+        if not s > 0.0 or y * y > gate * gate * s:
+            return Outcome.REJECTED_OUTLIER
+        k = Ph / s
+        self.x += k * y
+        self.x[Idx.YAW] = wrap_angle(self.x[Idx.YAW])
+        # Joseph form for one row: (I - k h) P (I - k h)^T + k var k^T
+        kh_p = np.outer(k, Ph)
+        self.P = self.P - kh_p - kh_p.T + np.outer(k, k) * s
+        return Outcome.ACCEPTED
+
+    def set_pose(self, x_m: float, y_m: float, yaw_rad: float, sigma_pos_m: float,
+                 sigma_yaw_rad: float) -> None:
+        """Reset the pose (and its covariance, decorrelated from the rest)."""
+        for i, value, sigma in ((Idx.X, x_m, sigma_pos_m), (Idx.Y, y_m, sigma_pos_m),
+                                (Idx.YAW, wrap_angle(yaw_rad), sigma_yaw_rad)):
+            self.x[i] = value
+            self.P[i, :] = 0.0
+            self.P[:, i] = 0.0
+            self.P[i, i] = sigma * sigma

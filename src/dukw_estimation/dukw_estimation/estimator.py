@@ -1,0 +1,418 @@
+"""The estimator: motion EKF + slip + hull submersion + track forces, ROS-free.
+
+Feed it ``samples`` dataclasses in time order (``add_*``), ask for ``odometry()`` and
+``traction()``. It rejects NaN, out-of-order and Mahalanobis-outlier measurements and
+counts them per sensor; a sensor silent for ``sensor_timeout_s`` is reported stale and the
+filter goes on predicting without it (robot_localization's behaviour).
+"""
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+
+import numpy as np
+
+from dukw_common.diagnostics import Health, Level, RateCounter
+from dukw_common.geometry import local_enu_from_geodetic, wrap_angle
+from dukw_common.vehicle import SoilParams, Vehicle
+from dukw_estimation import buoyancy, traction
+from dukw_estimation.ekf import N_STATES, Idx, MotionEkf, Outcome, ProcessNoise
+from dukw_estimation.force_filter import ForceSmoother
+from dukw_estimation.samples import (DepthReading, DriveStatus, GpsFix, GpsVelocity,
+                                     ImuSample, OdometryEstimate, TractionEstimate,
+                                     WaterContact)
+from dukw_estimation.settings import SENSORS, EkfSettings
+
+MAX_PREDICT_STEP_S = 0.02
+GROUNDED_FRACTION = 0.5          # above this weight share the pitch is the beach slope
+FRACTION_PERIOD_S = 0.1          # how often the IMU path refreshes the weight share
+
+
+class Estimator:
+    """Everything ekf_node computes, without ROS."""
+
+    def __init__(self, vehicle: Vehicle, settings: EkfSettings, soil: SoilParams) -> None:
+        self.vehicle = vehicle
+        self.settings = settings
+        self.soil = soil
+        body = vehicle.body
+        # the hull cylinders: waterline length centred on base_link (under the LCG), as the
+        # simulator's hull strips; inside bow_x_m .. stern_x_m of the overall length
+        self.hull_bow_x_m = min(0.5 * body.hull_length_m, body.bow_x_m)
+        self.hull_stern_x_m = max(-0.5 * body.hull_length_m, body.stern_x_m)
+        self.track_area_m2 = body.track_width_m * body.track_contact_length_m
+        self.counters: dict[str, dict[Outcome, int]] = {s: defaultdict(int) for s in SENSORS}
+        self.rates = {s: RateCounter() for s in SENSORS}
+        self.reset()
+
+    # ------------------------------------------------------------------ state
+    def reset(self) -> None:
+        """Forget everything but the counters: back to the initial covariance."""
+        st = self.settings
+        p0 = np.array([st.init_position_m ** 2, st.init_position_m ** 2, st.init_yaw_rad ** 2,
+                       st.init_velocity_mps ** 2, st.init_velocity_mps ** 2,
+                       st.init_yaw_rate_rps ** 2, st.init_gyro_bias_rps ** 2,
+                       st.waterline_sigma_m ** 2, st.wave_sigma_m ** 2 + 1e-6,
+                       (st.wave_sigma_m * 2 * math.pi * st.wave_peak_frequency_hz) ** 2 + 1e-6])
+        noise = ProcessNoise(st.q_position_m, st.q_yaw_rad, st.q_accel_mps2, st.q_yaw_accel_rps2,
+                             st.q_gyro_bias_rps, st.q_waterline_m,
+                             2 * math.pi * st.wave_peak_frequency_hz, st.wave_damping_ratio,
+                             st.wave_sigma_m)
+        self.ekf = MotionEkf(np.zeros(N_STATES), p0, noise, st.seaward_yaw_rad)
+        self.t_s: float | None = None
+        self.last_t = {s: -math.inf for s in SENSORS}
+        self.datum: tuple[float, float, float] | None = None
+        if not st.datum_from_first_fix:
+            self.datum = (st.datum_latitude_deg, st.datum_longitude_deg, st.datum_altitude_m)
+        self.position_set = False
+        self.yaw_set = False
+        self.imu: ImuSample | None = None
+        self.tracks: DriveStatus | None = None
+        self.props: DriveStatus | None = None
+        self.slope_rad = self.vehicle.site.beach_slope_rad
+        self.fraction = 1.0
+        self._fraction_t_s = -math.inf
+        self.force = [ForceSmoother(st.force_process_n_per_s, st.force_measurement_n)
+                      for _ in range(2)]
+
+    def set_pose(self, x_m: float, y_m: float, yaw_rad: float) -> bool:
+        """Reset the pose in odom; the waterline distance follows the new position."""
+        if not all(math.isfinite(v) for v in (x_m, y_m, yaw_rad)):
+            return False
+        self.ekf.set_pose(x_m, y_m, yaw_rad, self.settings.init_position_m,
+                          self.settings.init_yaw_rad)
+        self._init_waterline()
+        self.position_set = self.yaw_set = True
+        return True
+
+    def _init_waterline(self) -> None:
+        st = self.settings
+        x = self.ekf.x
+        seaward = ((x[Idx.X] - st.waterline_x_m) * math.cos(st.seaward_yaw_rad)
+                   + (x[Idx.Y] - st.waterline_y_m) * math.sin(st.seaward_yaw_rad))
+        x[Idx.S] = seaward / math.cos(self.vehicle.site.beach_slope_rad)
+        self.ekf.P[Idx.S, :] = 0.0
+        self.ekf.P[:, Idx.S] = 0.0
+        self.ekf.P[Idx.S, Idx.S] = st.waterline_sigma_m ** 2 + self.ekf.P[Idx.X, Idx.X]
+
+    # ------------------------------------------------------------------ time
+    def _fresh(self, sensor: str, t_s: float) -> bool:
+        return t_s - self.last_t[sensor] <= self.settings.sensor_timeout_s
+
+    def advance(self, t_s: float) -> None:
+        """Predict the filter forward to ``t_s`` (no-op when ``t_s`` is not newer)."""
+        if self.t_s is None:
+            self.t_s = t_s
+            return
+        while t_s > self.t_s:
+            dt = min(MAX_PREDICT_STEP_S, t_s - self.t_s)
+            self._predict(dt)
+            self.t_s += dt
+
+    def _predict(self, dt: float) -> None:
+        x = self.ekf.x
+        st = self.settings
+        now = self.t_s + dt
+        imu = self.imu
+        accel = None
+        noise = None
+        target = None
+        if imu is not None and self._fresh('imu', now) and math.isfinite(imu.accel_x_mps2):
+            g = self.vehicle.body.gravity_mps2
+            accel = (imu.accel_x_mps2 + g * math.sin(imu.pitch_rad) + x[Idx.R] * x[Idx.V],
+                     imu.accel_y_mps2 - g * math.sin(imu.roll_rad) * math.cos(imu.pitch_rad)
+                     - x[Idx.R] * x[Idx.U])
+        else:
+            noise = st.q_accel_no_imu_mps2
+            target = self._drive_target(now)
+        self.ekf.predict(dt, accel, target, noise, self.vehicle.site.beach_slope_rad)
+
+    def _drive_target(self, now: float) -> tuple[float, float, float] | None:
+        st = self.settings
+        tau = st.drive_time_constant_s
+        if self.fraction > GROUNDED_FRACTION and self.tracks is not None \
+                and self._fresh('tracks', now):
+            vp, vs = self.tracks.port.speed_mps, self.tracks.stbd.speed_mps
+            return 0.5 * (vp + vs), (vs - vp) / st.effective_track_width_m, tau
+        if self.props is not None and self._fresh('props', now):
+            thrust = self.props.port.force_n + self.props.stbd.force_n
+            speed = math.copysign(math.sqrt(abs(thrust) / st.water_drag_n_per_mps2), thrust)
+            return speed, float(self.ekf.x[Idx.R]), tau
+        return None
+
+    def _admit(self, sensor: str, t_s: float, values: tuple[float, ...]) -> Outcome | None:
+        """Common checks; returns a rejection outcome, or None when the sample may be used."""
+        if not self.settings.sensor_enabled(sensor):
+            return self._count(sensor, Outcome.IGNORED)
+        if not all(math.isfinite(v) for v in (t_s, *values)):
+            return self._count(sensor, Outcome.REJECTED_NAN)
+        too_old = self.t_s is not None and t_s < self.t_s - self.settings.max_lag_s
+        if t_s <= self.last_t[sensor] or too_old:
+            return self._count(sensor, Outcome.REJECTED_OUT_OF_ORDER)
+        self.advance(t_s)
+        self.last_t[sensor] = t_s
+        self.rates[sensor].tick(t_s)
+        return None
+
+    def _count(self, sensor: str, outcome: Outcome) -> Outcome:
+        self.counters[sensor][outcome] += 1
+        return outcome
+
+    # ------------------------------------------------------------------ sensors
+    def add_imu(self, s: ImuSample) -> Outcome:
+        """Attitude, gyro rate and accelerations; corrects yaw rate, bias and heading."""
+        rejected = self._admit('imu', s.t_s, (s.roll_rad, s.pitch_rad, s.yaw_rate_rps,
+                                              s.roll_rate_rps, s.pitch_rate_rps))
+        if rejected:
+            return rejected
+        dt = s.t_s - self.imu.t_s if self.imu is not None else 0.0
+        self.imu = s
+        st = self.settings
+        h = np.zeros(N_STATES)
+        h[Idx.R] = h[Idx.BIAS] = 1.0
+        var = s.yaw_rate_var_rps2 if s.yaw_rate_var_rps2 > 0 else st.gyro_rps ** 2
+        out = self.ekf.update_scalar(s.yaw_rate_rps, self.ekf.x[Idx.R] + self.ekf.x[Idx.BIAS],
+                                     h, var, st.gate_imu)
+        if math.isfinite(s.yaw_rad):
+            if not self.yaw_set:
+                self.ekf.x[Idx.YAW] = wrap_angle(s.yaw_rad)
+                self.yaw_set = True
+            h = np.zeros(N_STATES)
+            h[Idx.YAW] = 1.0
+            var = s.yaw_var_rad2 if s.yaw_var_rad2 > 0 else st.yaw_rad ** 2
+            yaw_out = self.ekf.update_scalar(s.yaw_rad, self.ekf.x[Idx.YAW], h, var,
+                                             st.gate_imu, angle=True)
+            if yaw_out is not Outcome.ACCEPTED:
+                out = yaw_out
+        self._update_slope(s, dt)
+        return self._count('imu', out)
+
+    def _update_slope(self, s: ImuSample, dt: float) -> None:
+        """Low-pass the beach slope along the seaward direction from pitch and roll."""
+        if s.t_s - self._fraction_t_s >= FRACTION_PERIOD_S:
+            self.traction()          # refreshes the weight share
+        if self.fraction <= GROUNDED_FRACTION:
+            return
+        rel = self.ekf.x[Idx.YAW] - self.settings.seaward_yaw_rad
+        measured = s.pitch_rad * math.cos(rel) + s.roll_rad * math.sin(rel)
+        alpha = min(dt / self.settings.slope_time_constant_s, 1.0)
+        self.slope_rad += alpha * (measured - self.slope_rad)
+
+    def _lever_arm(self) -> tuple[float, float, float, float]:
+        """Antenna offset terms: (a, b, p, q) with a = h sin(pitch) cos(roll), b = h sin(roll)."""
+        h = self.vehicle.sensors.gps_antenna_z_m
+        imu = self.imu
+        if imu is None:
+            return 0.0, 0.0, 0.0, 0.0
+        return (h * math.sin(imu.pitch_rad) * math.cos(imu.roll_rad), h * math.sin(imu.roll_rad),
+                imu.roll_rate_rps, imu.pitch_rate_rps)
+
+    def add_gps_fix(self, s: GpsFix) -> Outcome:
+        """DGPS position (geodetic) -> local ENU at the datum; corrects x, y."""
+        if not s.valid and self.settings.use_gps_fix:
+            return self._count('gps_fix', Outcome.IGNORED)
+        rejected = self._admit('gps_fix', s.t_s, (s.latitude_deg, s.longitude_deg, s.altitude_m))
+        if rejected:
+            return rejected
+        if self.datum is None:
+            self.datum = (s.latitude_deg, s.longitude_deg, s.altitude_m)
+        east, north, _ = local_enu_from_geodetic(s.latitude_deg, s.longitude_deg, s.altitude_m,
+                                                 *self.datum)
+        x = self.ekf.x
+        a, b, _, _ = self._lever_arm()
+        c, sn = math.cos(x[Idx.YAW]), math.sin(x[Idx.YAW])
+        offset = np.array([c * a + sn * b, sn * a - c * b])
+        if not self.position_set:
+            x[Idx.X], x[Idx.Y] = east - offset[0], north - offset[1]
+            self._init_waterline()
+            self.position_set = True
+        H = np.zeros((2, N_STATES))
+        H[0, Idx.X] = H[1, Idx.Y] = 1.0
+        H[0, Idx.YAW] = -sn * a + c * b
+        H[1, Idx.YAW] = c * a + sn * b
+        var = s.horizontal_var_m2 if s.horizontal_var_m2 > 0 else self.settings.gps_position_m ** 2
+        out = self.ekf.update(np.array([east, north]), x[[Idx.X, Idx.Y]] + offset, H,
+                              np.eye(2) * var, self.settings.gate_gps_fix)
+        return self._count('gps_fix', out)
+
+    def add_gps_velocity(self, s: GpsVelocity) -> Outcome:
+        """DGPS ground velocity of the antenna (ENU); corrects u, v and yaw."""
+        rejected = self._admit('gps_vel', s.t_s, (s.east_mps, s.north_mps))
+        if rejected:
+            return rejected
+        x = self.ekf.x
+        h = self.vehicle.sensors.gps_antenna_z_m
+        _, _, p, q = self._lever_arm()
+        ub, vb = x[Idx.U] + q * h, x[Idx.V] - p * h
+        c, sn = math.cos(x[Idx.YAW]), math.sin(x[Idx.YAW])
+        H = np.zeros((2, N_STATES))
+        H[0, Idx.U], H[0, Idx.V], H[0, Idx.YAW] = c, -sn, -sn * ub - c * vb
+        H[1, Idx.U], H[1, Idx.V], H[1, Idx.YAW] = sn, c, c * ub - sn * vb
+        var = s.var_mps2 if s.var_mps2 > 0 else self.settings.gps_velocity_mps ** 2
+        out = self.ekf.update(np.array([s.east_mps, s.north_mps]),
+                              np.array([c * ub - sn * vb, sn * ub + c * vb]), H,
+                              np.eye(2) * var, self.settings.gate_gps_vel)
+        return self._count('gps_vel', out)
+
+    def add_water_contact(self, s: WaterContact) -> Outcome:
+        """Wet/dry sensors: where the state disagrees, the surface is at the sensor."""
+        rejected = self._admit('water', s.t_s, ())
+        if rejected:
+            return rejected
+        mounts = self.vehicle.sensors
+        out = Outcome.IGNORED
+        for wet, x_m, z_m in ((s.fore_wet, mounts.fore_water_x_m, mounts.fore_water_z_m),
+                              (s.aft_wet, mounts.aft_water_x_m, mounts.aft_water_z_m)):
+            depth, h = self._sensor_depth(x_m, z_m)
+            if bool(wet) == (depth > 0.0):
+                continue
+            result = self.ekf.update_scalar(0.0, depth, h, self.settings.contact_m ** 2,
+                                            self.settings.gate_water)
+            if out is not Outcome.REJECTED_OUTLIER:
+                out = result
+        if out is Outcome.IGNORED:
+            out = Outcome.ACCEPTED    # consistent with the state: nothing to correct
+        return self._count('water', out)
+
+    def _sensor_depth(self, x_m: float, z_m: float) -> tuple[float, np.ndarray]:
+        """Water over a sensor at body (x, z) of a vehicle on the slope, and its Jacobian."""
+        x = self.ekf.x
+        sin_t, cos_t = math.sin(self.slope_rad), math.cos(self.slope_rad)
+        rel = x[Idx.YAW] - self.settings.seaward_yaw_rad
+        depth = x[Idx.ETA] + (x[Idx.S] + x_m * math.cos(rel)) * sin_t - z_m * cos_t
+        h = np.zeros(N_STATES)
+        h[Idx.ETA] = 1.0
+        h[Idx.S] = sin_t
+        h[Idx.YAW] = -x_m * math.sin(rel) * sin_t
+        return depth, h
+
+    def add_depth(self, s: DepthReading) -> Outcome:
+        """A valid sounding means the transducer floats above the sea bed: corrects s, eta."""
+        if not s.valid:
+            rejected = self._admit('depth', s.t_s, ())
+            return rejected or self._count('depth', Outcome.IGNORED)
+        rejected = self._admit('depth', s.t_s, (s.depth_m,))
+        if rejected:
+            return rejected
+        x = self.ekf.x
+        body, mounts, site = self.vehicle.body, self.vehicle.sensors, self.vehicle.site
+        sin_t = math.sin(self.slope_rad)
+        floor_depth = x[Idx.S] * sin_t
+        h = np.zeros(N_STATES)
+        h[Idx.ETA] = 1.0
+        if floor_depth < site.sea_floor_depth_m:
+            h[Idx.S] = sin_t
+        floor_depth = min(floor_depth, site.sea_floor_depth_m)
+        predicted = x[Idx.ETA] - body.draft_m + mounts.depth_sounder_z_m + floor_depth
+        out = self.ekf.update_scalar(s.depth_m, predicted, h, self.settings.depth_m ** 2,
+                                     self.settings.gate_depth)
+        return self._count('depth', out)
+
+    def add_tracks(self, s: DriveStatus) -> Outcome:
+        """Track speeds (slip, drive model) and measured forces (smoothed)."""
+        values = (s.port.speed_mps, s.stbd.speed_mps)
+        rejected = self._admit('tracks', s.t_s, values)
+        if rejected:
+            return rejected
+        self.tracks = s
+        gain = self.vehicle.drivetrain.track_force_gain_n_per_a
+        for smoother, side in zip(self.force, (s.port, s.stbd), strict=True):
+            force = side.force_n if math.isfinite(side.force_n) else side.current_a * gain
+            smoother.update(s.t_s, force)
+        if not self._fresh('gps_vel', s.t_s) and self.fraction > GROUNDED_FRACTION:
+            self._track_odometry(s)
+        return self._count('tracks', Outcome.ACCEPTED)
+
+    def _track_odometry(self, s: DriveStatus) -> None:
+        """GPS velocity stale on land: the tracks say roughly how fast we go."""
+        st = self.settings
+        H = np.zeros((2, N_STATES))
+        H[0, Idx.U] = H[1, Idx.R] = 1.0
+        z = np.array([0.5 * (s.port.speed_mps + s.stbd.speed_mps),
+                      (s.stbd.speed_mps - s.port.speed_mps) / st.effective_track_width_m])
+        var = st.track_odometry_mps ** 2
+        R = np.diag([var, var / st.effective_track_width_m ** 2])
+        self.ekf.update(z, self.ekf.x[[Idx.U, Idx.R]], H, R, math.inf)
+
+    def add_props(self, s: DriveStatus) -> Outcome:
+        """Propeller thrusts, for the drive model afloat."""
+        rejected = self._admit('props', s.t_s, (s.port.force_n, s.stbd.force_n))
+        if rejected:
+            return rejected
+        self.props = s
+        return self._count('props', Outcome.ACCEPTED)
+
+    # ------------------------------------------------------------------ outputs
+    def odometry(self) -> OdometryEstimate:
+        """Pose and twist of base_link in odom with covariances."""
+        x, P = self.ekf.x, self.ekf.P
+        roll = self.imu.roll_rad if self.imu else 0.0
+        pitch = self.imu.pitch_rad if self.imu else 0.0
+        pose_cov = np.diag([0.0, 0.0, 1e3, 1e-2, 1e-2, 0.0])
+        ix = [Idx.X, Idx.Y]
+        pose_cov[np.ix_([0, 1], [0, 1])] = P[np.ix_(ix, ix)]
+        pose_cov[np.ix_([0, 1], [5])] = P[np.ix_(ix, [Idx.YAW])]
+        pose_cov[np.ix_([5], [0, 1])] = P[np.ix_([Idx.YAW], ix)]
+        pose_cov[5, 5] = P[Idx.YAW, Idx.YAW]
+        twist_cov = np.diag([0.0, 0.0, 1e3, 1e3, 1e3, 0.0])
+        it = [Idx.U, Idx.V]
+        twist_cov[np.ix_([0, 1], [0, 1])] = P[np.ix_(it, it)]
+        twist_cov[5, 5] = P[Idx.R, Idx.R]
+        z = -x[Idx.S] * math.sin(self.slope_rad)
+        return OdometryEstimate(self.t_s or 0.0, float(x[Idx.X]), float(x[Idx.Y]), z, roll,
+                                pitch, float(x[Idx.YAW]), float(x[Idx.U]), float(x[Idx.V]),
+                                float(x[Idx.R]), pose_cov, twist_cov)
+
+    def traction(self) -> TractionEstimate:
+        """Slip per track, submersion (h2, volume, W_e, weight share) and track forces."""
+        x = self.ekf.x
+        body = self.vehicle.body
+        slope = self.slope_rad
+        heading_cos = math.cos(x[Idx.YAW] - self.settings.seaward_yaw_rad)
+        args = (x[Idx.S], slope, body.hull_clearance_m, self.hull_bow_x_m, self.hull_stern_x_m)
+        h2 = buoyancy.submerged_length_m(*args, x[Idx.ETA], heading_cos)
+        volume = buoyancy.grounded_volume_m3(*args, body.hull_radius_m, x[Idx.ETA], heading_cos)
+        afloat = volume >= body.displaced_volume_m3
+        volume = min(volume, body.displaced_volume_m3)
+        weight = traction.effective_weight_n(body.displacement_n, volume, slope,
+                                             body.water_density_kgpm3, body.gravity_mps2)
+        self.fraction = weight / (body.displacement_n * math.cos(slope))
+        self._fraction_t_s = self.t_s or 0.0
+        half = 0.5 * body.hull_separation_m
+        ground = (x[Idx.U] - x[Idx.R] * half, x[Idx.U] + x[Idx.R] * half)
+        slips = [math.nan, math.nan]
+        predicted = [math.nan, math.nan]
+        if self.tracks is not None:
+            speeds = (self.tracks.port.speed_mps, self.tracks.stbd.speed_mps)
+            for k in range(2):
+                slips[k] = traction.slip(speeds[k], ground[k])
+                predicted[k] = traction.tractive_force_n(slips[k], 0.5 * weight, self.soil,
+                                                         self.track_area_m2,
+                                                         body.track_contact_length_m)
+        return TractionEstimate(self.t_s or 0.0, slips[0], slips[1], volume, weight,
+                                self.fraction, float(x[Idx.S]), h2, slope, predicted[0],
+                                predicted[1], self.force[0].force_n, self.force[1].force_n,
+                                afloat, float(x[Idx.ETA]))
+
+    def health(self, now_s: float) -> list[Health]:
+        """One Health per sensor (stale -> WARN, rejections counted) and one for the filter."""
+        out = []
+        for sensor in SENSORS:
+            counts = self.counters[sensor]
+            health = Health(sensor, values={o.value: counts[o] for o in Outcome})
+            health.values['rate_hz'] = round(self.rates[sensor].rate_hz(now_s), 2)
+            if self.settings.sensor_enabled(sensor):
+                age = now_s - self.last_t[sensor]
+                if age > self.settings.sensor_timeout_s:
+                    health.worsen(Level.WARN, 'silent: predict-only without it'
+                                  if math.isfinite(age) else 'no data yet: predict-only')
+            else:
+                health.message = 'disabled'
+            out.append(health)
+        sigma = math.sqrt(max(self.ekf.P[Idx.X, Idx.X], self.ekf.P[Idx.Y, Idx.Y]))
+        filt = Health('filter', values={'position_sigma_m': round(sigma, 3),
+                                        'initialised': self.position_set and self.yaw_set})
+        if not (self.position_set and self.yaw_set):
+            filt.worsen(Level.WARN, 'waiting for a fix and a heading')
+        out.append(filt)
+        return out

@@ -1,0 +1,156 @@
+"""The estimator's tuning, robot_localization style, as one typed dataclass.
+
+Every field is an ``ekf_node`` parameter in config/dukw.yaml (dotted names, e.g.
+``noise.gps_position_m``); ``SETTING_SPECS`` gives each one's meaning and range so the
+node declares them without repeating the list. Geometry and soil come from ``Vehicle``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields
+from typing import Mapping
+
+from dukw_common.config import ConfigError, ParamValue
+
+_KINDS = {'float': float, 'bool': bool, 'str': str}
+SENSORS = ('imu', 'gps_fix', 'gps_vel', 'water', 'depth', 'tracks', 'props')
+
+
+def _f(name: str, description: str, lo: float | None = None, hi: float | None = None):
+    return field(metadata={'name': name, 'description': description, 'min': lo, 'max': hi})
+
+
+@dataclass(frozen=True)
+class EkfSettings:
+    """Filter tuning. Sigmas are one standard deviation; process noise per sqrt(second)."""
+
+    rate_hz: float = _f('rate_hz', 'output rate of odometry/filtered and traction, Hz', 0.1, 1000)
+    sensor_timeout_s: float = _f('sensor_timeout_s',
+                                 'a sensor silent this long is stale (predict-only, WARN)',
+                                 0.01, 60)
+    max_lag_s: float = _f('max_lag_s', 'measurements older than the filter by more than this '
+                          'are rejected as out of order; younger ones apply at filter time',
+                          0.0, 10)
+    # datum of the local ENU frame
+    datum_from_first_fix: bool = _f('datum.from_first_fix',
+                                    'take the datum from the first GPS fix')
+    datum_latitude_deg: float = _f('datum.latitude_deg', 'datum latitude', -90, 90)
+    datum_longitude_deg: float = _f('datum.longitude_deg', 'datum longitude', -180, 180)
+    datum_altitude_m: float = _f('datum.altitude_m', 'datum altitude', -1e4, 1e4)
+    # the shore in odom
+    waterline_x_m: float = _f('shore.waterline_x_m', 'a point on the mean waterline, odom x',
+                              -1e6, 1e6)
+    waterline_y_m: float = _f('shore.waterline_y_m', 'a point on the mean waterline, odom y',
+                              -1e6, 1e6)
+    seaward_yaw_rad: float = _f('shore.seaward_yaw_rad',
+                                'direction pointing seaward, perpendicular to the waterline',
+                                -math.pi, math.pi)
+    waterline_sigma_m: float = _f('shore.waterline_sigma_m',
+                                  'uncertainty of the surveyed waterline (tide, survey)', 0, 100)
+    # per-sensor enable
+    use_imu: bool = _f('enable.imu', 'fuse imu/data')
+    use_gps_fix: bool = _f('enable.gps_fix', 'fuse gps/fix')
+    use_gps_vel: bool = _f('enable.gps_vel', 'fuse gps/vel')
+    use_water: bool = _f('enable.water', 'fuse water/contact')
+    use_depth: bool = _f('enable.depth', 'fuse depth')
+    use_tracks: bool = _f('enable.tracks', 'use tracks/status (slip, forces, drive model)')
+    use_props: bool = _f('enable.props', 'use props/status (drive model afloat)')
+    # measurement noise (used when a message carries no covariance)
+    gps_position_m: float = _f('noise.gps_position_m', 'DGPS position sigma', 1e-4, 100)
+    gps_velocity_mps: float = _f('noise.gps_velocity_mps', 'DGPS velocity sigma', 1e-4, 10)
+    yaw_rad: float = _f('noise.yaw_rad', 'IMU/compass heading sigma', 1e-5, 1)
+    gyro_rps: float = _f('noise.gyro_rps', 'gyro z sigma', 1e-6, 1)
+    contact_m: float = _f('noise.contact_m', 'water surface at a wet/dry boundary sigma',
+                          1e-4, 1)
+    depth_m: float = _f('noise.depth_m', 'depth sounder sigma (incl. heave)', 1e-4, 5)
+    track_odometry_mps: float = _f('noise.track_odometry_mps',
+                                   'track-speed pseudo-measurement sigma (GPS stale)', 1e-3, 10)
+    # process noise
+    q_position_m: float = _f('process.position_m', 'position random walk', 0, 10)
+    q_yaw_rad: float = _f('process.yaw_rad', 'heading random walk', 0, 10)
+    q_accel_mps2: float = _f('process.accel_mps2',
+                             'velocity noise with IMU accelerations as input', 1e-6, 100)
+    q_accel_no_imu_mps2: float = _f('process.accel_no_imu_mps2',
+                                    'velocity noise without the IMU (drive model)', 1e-6, 100)
+    q_yaw_accel_rps2: float = _f('process.yaw_accel_rps2', 'yaw-rate random walk', 1e-6, 100)
+    q_gyro_bias_rps: float = _f('process.gyro_bias_rps', 'gyro bias random walk', 0, 1)
+    q_waterline_m: float = _f('process.waterline_m', 'waterline distance random walk', 0, 10)
+    # initial covariance (sigmas)
+    init_position_m: float = _f('initial_sigma.position_m', 'initial position sigma', 1e-4, 1e4)
+    init_yaw_rad: float = _f('initial_sigma.yaw_rad', 'initial heading sigma', 1e-4, 10)
+    init_velocity_mps: float = _f('initial_sigma.velocity_mps', 'initial velocity sigma',
+                                  1e-4, 100)
+    init_yaw_rate_rps: float = _f('initial_sigma.yaw_rate_rps', 'initial yaw-rate sigma',
+                                  1e-4, 10)
+    init_gyro_bias_rps: float = _f('initial_sigma.gyro_bias_rps', 'initial gyro-bias sigma',
+                                   1e-6, 1)
+    # Mahalanobis rejection thresholds (distance, not squared)
+    gate_imu: float = _f('mahalanobis.imu', 'IMU heading/gyro rejection distance', 0.5, 1e6)
+    gate_gps_fix: float = _f('mahalanobis.gps_fix', 'GPS position rejection distance', 0.5, 1e6)
+    gate_gps_vel: float = _f('mahalanobis.gps_vel', 'GPS velocity rejection distance', 0.5, 1e6)
+    gate_water: float = _f('mahalanobis.water', 'water-contact rejection distance', 0.5, 1e6)
+    gate_depth: float = _f('mahalanobis.depth', 'depth rejection distance', 0.5, 1e6)
+    # wave surface at the vehicle: a damped oscillator driven by noise
+    wave_peak_frequency_hz: float = _f('wave.peak_frequency_hz',
+                                       'dominant wave frequency (vehicle.md 5: 0.27-0.29)',
+                                       0.01, 5)
+    wave_damping_ratio: float = _f('wave.damping_ratio', 'oscillator damping (sea bandwidth)',
+                                   0.01, 2)
+    wave_sigma_m: float = _f('wave.sigma_m', 'wave elevation sigma, ~ H1/3 / 4', 0, 2)
+    # beach slope from pitch/roll
+    slope_time_constant_s: float = _f('slope.time_constant_s', 'low-pass of the pitch slope',
+                                      0.01, 100)
+    # drive model (no IMU, or GPS stale)
+    drive_time_constant_s: float = _f('drive_model.time_constant_s',
+                                      'velocity lag behind the tracks / thrust', 0.01, 100)
+    effective_track_width_m: float = _f('drive_model.effective_track_width_m',
+                                        'skid-steer effective track separation', 0.1, 10)
+    water_drag_n_per_mps2: float = _f('drive_model.water_drag_n_per_mps2',
+                                      'quadratic surge drag afloat (266 N at 1.2 m/s)', 1, 1e5)
+    # track forces
+    force_process_n_per_s: float = _f('force_filter.process_n_per_s',
+                                      'track-force smoother: force rate noise', 1e-3, 1e5)
+    force_measurement_n: float = _f('force_filter.measurement_n',
+                                    'track-force smoother: current x gain noise', 1e-3, 1e4)
+    soil_preset: str = _f('soil_preset', "soil preset name; '' uses soil.*")
+
+    @classmethod
+    def from_params(cls, params: Mapping[str, ParamValue]) -> 'EkfSettings':
+        """Build from a node's dotted parameters; ConfigError names a missing or bad one."""
+        values = {}
+        for f in fields(cls):
+            name = f.metadata['name']
+            if name not in params:
+                raise ConfigError(f'ekf_node: missing parameter {name!r}')
+            value = params[name]
+            kind = _KINDS[f.type]
+            if kind is bool:
+                if not isinstance(value, bool):
+                    raise ConfigError(f'ekf_node: parameter {name!r} must be a bool')
+            elif kind is float:
+                if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                        or not math.isfinite(value):
+                    raise ConfigError(f'ekf_node: parameter {name!r} must be a finite number')
+                value = float(value)
+                lo, hi = f.metadata['min'], f.metadata['max']
+                if (lo is not None and value < lo) or (hi is not None and value > hi):
+                    raise ConfigError(f'ekf_node: parameter {name!r} = {value} outside '
+                                      f'[{lo}, {hi}]')
+            else:
+                value = str(value)
+            values[f.name] = value
+        return cls(**values)
+
+    def sensor_enabled(self, sensor: str) -> bool:
+        """Whether ``sensor`` (one of SENSORS) is fused."""
+        return getattr(self, f'use_{sensor}')
+
+    def gate(self, sensor: str) -> float:
+        """Mahalanobis rejection distance of ``sensor``."""
+        return getattr(self, f'gate_{sensor}', math.inf)
+
+
+def setting_specs() -> list[tuple[str, str, float | None, float | None]]:
+    """(parameter name, description, min, max) of every setting, for ParamSpec."""
+    return [(f.metadata['name'], f.metadata['description'], f.metadata['min'],
+             f.metadata['max']) for f in fields(EkfSettings)]

@@ -1,0 +1,229 @@
+"""The ROS-free estimator on synthetic, seeded sensor streams."""
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from dukw_common.config import ConfigError, node_params
+from dukw_common.diagnostics import Level
+from dukw_common.geometry import geodetic_from_local_enu
+from dukw_common.vehicle import Vehicle, soil_params
+from dukw_estimation import traction
+from dukw_estimation.ekf import Idx, Outcome
+from dukw_estimation.estimator import Estimator
+from dukw_estimation.force_filter import ForceSmoother
+from dukw_estimation.samples import (DepthReading, DriveStatus, GpsFix, GpsVelocity,
+                                     ImuSample, MotorSide, WaterContact)
+from dukw_estimation.settings import EkfSettings
+
+PARAMS = node_params('ekf_node')
+SETTINGS = EkfSettings.from_params(PARAMS)
+VEHICLE = Vehicle.from_params(PARAMS)
+DATUM = (SETTINGS.datum_latitude_deg, SETTINGS.datum_longitude_deg, 0.0)
+G = VEHICLE.body.gravity_mps2
+
+
+def make(**changes) -> Estimator:
+    return Estimator(VEHICLE, dataclasses.replace(SETTINGS, **changes), soil_params(PARAMS))
+
+
+def fix(t, x, y, var=math.nan):
+    lat, lon, alt = geodetic_from_local_enu(x, y, 0.0, *DATUM)
+    return GpsFix(t, lat, lon, alt, var)
+
+
+def imu(t, yaw, rate, ax=0.0, ay=0.0, pitch=0.0):
+    return ImuSample(t, 0.0, pitch, yaw, 0.0, 0.0, rate, ax - G * math.sin(pitch), ay,
+                     G * math.cos(pitch))
+
+
+def tracks(t, port_mps, stbd_mps, force_n=100.0):
+    return DriveStatus(t, MotorSide(50.0, 10.0, port_mps, force_n),
+                       MotorSide(50.0, 10.0, stbd_mps, force_n))
+
+
+class Drive:
+    """A vehicle on a circle (or a line) with noisy sensors at the simulator's rates."""
+
+    def __init__(self, est, u=1.0, r=0.2, x=-20.0, y=0.0, yaw=0.0, bias=0.01, seed=0,
+                 pitch=0.0):
+        self.est, self.u, self.r, self.pitch = est, u, r, pitch
+        self.x, self.y, self.yaw, self.bias = x, y, yaw, bias
+        self.rng = np.random.default_rng(seed)
+        self.t = 0.0
+
+    def run(self, seconds, track_speed=(1.1, 1.3), gps=True, extra=None):
+        n = self.rng.normal
+        for _ in range(int(round(seconds / 0.01))):
+            self.t += 0.01
+            self.x += self.u * math.cos(self.yaw) * 0.01
+            self.y += self.u * math.sin(self.yaw) * 0.01
+            self.yaw += self.r * 0.01
+            self.est.add_imu(imu(self.t, self.yaw + n(0, 0.005), self.r + self.bias
+                                 + n(0, 0.003), n(0, 0.01), self.r * self.u + n(0, 0.01),
+                                 self.pitch))
+            k = int(round(self.t * 100))
+            if gps and k % 10 == 0:
+                self.est.add_gps_fix(fix(self.t, self.x + n(0, 0.05), self.y + n(0, 0.05)))
+                self.est.add_gps_velocity(GpsVelocity(
+                    self.t, self.u * math.cos(self.yaw) + n(0, 0.03),
+                    self.u * math.sin(self.yaw) + n(0, 0.03)))
+            if k % 5 == 0:
+                self.est.add_tracks(tracks(self.t, *track_speed))
+                if extra:
+                    extra(self)
+
+
+def test_settings_refuse_missing_and_out_of_range_parameters():
+    bad = dict(PARAMS)
+    del bad['noise.gps_position_m']
+    with pytest.raises(ConfigError, match='noise.gps_position_m'):
+        EkfSettings.from_params(bad)
+    with pytest.raises(ConfigError, match='rate_hz'):
+        EkfSettings.from_params({**PARAMS, 'rate_hz': 0.0})
+    with pytest.raises(ConfigError, match='enable.imu'):
+        EkfSettings.from_params({**PARAMS, 'enable.imu': 1.0})
+
+
+def test_tracks_a_circle_and_learns_the_gyro_bias():
+    est = make()
+    drive = Drive(est)
+    drive.run(30.0)
+    odom = est.odometry()
+    assert (odom.x_m, odom.y_m) == pytest.approx((drive.x, drive.y), abs=0.1)
+    assert math.remainder(odom.yaw_rad - drive.yaw, 2 * math.pi) == pytest.approx(0, abs=0.02)
+    assert (odom.surge_mps, odom.yaw_rate_rps) == pytest.approx((1.0, 0.2), abs=0.05)
+    assert est.ekf.x[Idx.BIAS] == pytest.approx(0.01, abs=0.002)
+    assert odom.pose_cov[0, 0] < 0.01
+
+
+def test_slip_per_track_from_the_ground_speed_at_that_track():
+    est = make()
+    drive = Drive(est, u=1.0, r=0.2)
+    drive.run(5.0, track_speed=(1.1, 1.3))
+    slips = []
+    for _ in range(100):
+        drive.run(0.1, track_speed=(1.1, 1.3))
+        slips.append((est.traction().port_slip, est.traction().stbd_slip))
+    half = VEHICLE.body.hull_separation_m / 2
+    expected = (traction.slip(1.1, 1.0 - 0.2 * half), traction.slip(1.3, 1.0 + 0.2 * half))
+    rms = np.sqrt(np.mean((np.array(slips) - expected) ** 2, axis=0))
+    assert np.all(rms < 0.02)
+    # waves pushing the vehicle faster than the tracks: negative slip
+    est2 = make()
+    Drive(est2, u=1.0, r=0.0).run(20.0, track_speed=(0.8, 0.8))
+    assert est2.traction().port_slip == pytest.approx(-0.25, abs=0.05)
+
+
+def test_on_dry_land_all_weight_on_tracks_and_force_prediction_matches_the_model():
+    est = make()
+    Drive(est).run(10.0)
+    out = est.traction()
+    assert out.submerged_volume_m3 == 0.0 and not out.afloat
+    assert out.weight_on_tracks_fraction == pytest.approx(1.0)
+    soil = soil_params(PARAMS)
+    body = VEHICLE.body
+    expected = traction.tractive_force_n(out.port_slip, out.effective_weight_n / 2, soil,
+                                         body.track_width_m * body.track_contact_length_m,
+                                         body.track_contact_length_m)
+    assert out.port_force_predicted_n == pytest.approx(expected)
+    assert out.port_force_measured_n == pytest.approx(100.0)
+
+
+def test_nan_out_of_order_and_outliers_are_rejected_counted_and_change_nothing():
+    est = make()
+    Drive(est).run(5.0)
+    before = est.ekf.x.copy()
+    t = est.t_s
+    assert est.add_gps_fix(fix(t + 0.001, math.nan, 0.0)) is Outcome.REJECTED_NAN
+    assert est.add_imu(dataclasses.replace(imu(t + 0.002, 0.0, 0.0), yaw_rate_rps=math.nan)) \
+        is Outcome.REJECTED_NAN
+    assert est.add_gps_velocity(GpsVelocity(t - 5.0, 0.0, 0.0)) is \
+        Outcome.REJECTED_OUT_OF_ORDER
+    np.testing.assert_allclose(est.ekf.x, before, atol=1e-2)   # only a few ms of prediction
+    x_before = est.ekf.x.copy()
+    assert est.add_gps_fix(fix(t + 0.01, est.ekf.x[Idx.X] + 40.0, 0.0)) is \
+        Outcome.REJECTED_OUTLIER
+    assert est.ekf.x[Idx.X] == pytest.approx(x_before[Idx.X], abs=0.05)
+    assert est.counters['gps_fix'][Outcome.REJECTED_NAN] == 1
+    assert est.counters['gps_fix'][Outcome.REJECTED_OUTLIER] == 1
+    assert est.counters['gps_vel'][Outcome.REJECTED_OUT_OF_ORDER] == 1
+
+
+def test_silent_gps_is_reported_and_the_tracks_carry_the_speed():
+    est = make()
+    drive = Drive(est, r=0.0)
+    drive.run(5.0)
+    drive.run(5.0, track_speed=(1.0, 1.0), gps=False)
+    health = {h.name: h for h in est.health(est.t_s)}
+    assert health['gps_fix'].level == Level.WARN
+    assert 'predict-only' in health['gps_fix'].message
+    assert health['imu'].level == Level.OK
+    assert est.odometry().surge_mps == pytest.approx(1.0, abs=0.1)
+    assert est.odometry().x_m == pytest.approx(drive.x, abs=1.0)
+
+
+def test_water_contact_corrects_a_wrong_waterline_survey():
+    """Survey says the waterline is 2 m further seaward than it is; the fore sensor knows."""
+    slope = VEHICLE.site.beach_slope_rad
+    mounts = VEHICLE.sensors
+    est = make(waterline_x_m=2.0, wave_sigma_m=0.01)
+
+    def contact(drive):
+        s_true = drive.x / math.cos(slope)
+
+        def depth(x_m, z_m):
+            return (s_true + x_m) * math.sin(slope) - z_m * math.cos(slope)
+        est.add_water_contact(WaterContact(drive.t, depth(mounts.fore_water_x_m,
+                                                          mounts.fore_water_z_m) > 0,
+                                           depth(mounts.aft_water_x_m, mounts.aft_water_z_m) > 0))
+
+    drive = Drive(est, u=0.5, r=0.0, x=-2.0, pitch=slope)
+    drive.run(1.0, track_speed=(0.5, 0.5))
+    assert est.traction().waterline_distance_m == pytest.approx(-4.0, abs=0.6)
+    drive.run(13.0, track_speed=(0.5, 0.5), extra=contact)
+    s_true = drive.x / math.cos(slope)
+    assert est.traction().waterline_distance_m == pytest.approx(s_true, abs=0.5)
+    assert est.counters['water'][Outcome.ACCEPTED] > 0
+
+
+def test_deep_water_is_afloat_and_a_valid_sounding_pins_the_waterline_distance():
+    est = make(waterline_x_m=3.0)
+    drive = Drive(est, u=0.5, r=0.0, x=15.0)
+    slope = VEHICLE.site.beach_slope_rad
+    body, mounts = VEHICLE.body, VEHICLE.sensors
+
+    def sounding(d):
+        floor = min(d.x * math.tan(slope), VEHICLE.site.sea_floor_depth_m)
+        est.add_depth(DepthReading(d.t, True, floor - body.draft_m + mounts.depth_sounder_z_m))
+    drive.run(10.0, track_speed=(0.0, 0.0), extra=sounding)
+    out = est.traction()
+    assert out.afloat
+    assert out.weight_on_tracks_fraction == 0.0
+    assert out.submerged_volume_m3 == pytest.approx(VEHICLE.body.displaced_volume_m3)
+    assert out.waterline_distance_m == pytest.approx(drive.x / math.cos(slope), abs=1.0)
+
+
+def test_set_pose_resets_pose_and_refuses_nan():
+    est = make()
+    Drive(est).run(2.0)
+    assert est.set_pose(3.0, 4.0, 1.0)
+    assert (est.odometry().x_m, est.odometry().y_m, est.odometry().yaw_rad) == (3.0, 4.0, 1.0)
+    assert not est.set_pose(math.nan, 0.0, 0.0)
+
+
+def test_force_smoother_reduces_noise_and_follows_a_step():
+    rng = np.random.default_rng(3)
+    smoother = ForceSmoother(200.0, 15.0)
+    out = []
+    for k in range(400):
+        true = 100.0 if k < 200 else 300.0
+        smoother.update(k * 0.05, true + rng.normal(0, 15.0))
+        out.append(smoother.force_n)
+    out = np.array(out)
+    assert np.std(out[100:200] - 100.0) < 8.0
+    assert out[-1] == pytest.approx(300.0, abs=15.0)
+    assert not smoother.update(30.0, math.nan)
+    with pytest.raises(ValueError):
+        ForceSmoother(0.0, 1.0)
