@@ -45,13 +45,17 @@ def test_a_line_without_end_is_dropped_when_too_long():
 
 
 @settings(max_examples=300, deadline=None)
-@given(st.lists(st.binary(max_size=120), max_size=8))
-def test_random_bytes_never_raise(chunks):
+@given(st.lists(st.binary(max_size=30), max_size=8))
+def test_random_bytes_never_raise_and_every_line_is_accounted_for(chunks):
     stream = NmeaStream(['GGA', 'RMC', 'VTG', 'GST', 'DPT', 'DBT', 'MTW'])
     for chunk in chunks:
         stream.feed(chunk)
     stream.feed(b'\r\n')
-    assert stream.counters.sentences == 0 or b'$' in b''.join(chunks)
+    lines = b''.join(chunks).split(b'\n')
+    # every line that is not blank ends up as exactly one sentence, error or ignored one
+    expected = sum(1 for line in lines if b'$' in line or line.strip())
+    c = stream.counters
+    assert c.sentences + c.checksum_errors + c.parse_errors + c.ignored == expected
 
 
 @settings(max_examples=300, deadline=None)
