@@ -349,10 +349,20 @@ class DriveController:
         props = water.sides.scaled(prop_w)
         tracks = apply_port_bias(tracks, s.port_bias_land_pct, s.bias_full_above_pct)
         props = apply_port_bias(props, s.port_bias_water_pct, s.bias_full_above_pct)
-        tracks = SidePair(tracks.port * self.current['port'].scale,
-                          tracks.stbd * self.current['stbd'].scale)
+        if not self._descending(speed_sp):
+            tracks = SidePair(tracks.port * self.current['port'].scale,
+                              tracks.stbd * self.current['stbd'].scale)
         self.output = ControlOutput(tracks.scaled(fade), props.scaled(fade))
         return self.output
+
+    def _descending(self, speed_mps: float) -> bool:
+        """Driving down a slope steep enough to matter: the way off it is never derated.
+
+        Held or driven on a steep slope the load is gravity whatever the command, so
+        derating would only leave the vehicle stalled on it at the same current.
+        """
+        incline = self.i.incline_rad
+        return speed_mps * incline < 0.0 and abs(incline) > self.s.incline_sustained_rad / 2
 
     # --- diagnostics ------------------------------------------------------------------
     def healths(self, now_s: float) -> list[Health]:

@@ -1,0 +1,102 @@
+"""The control cores closed around the simulator core, with truth as the feedback.
+
+The controller sees what its node would see: surge speed and yaw rate (odometry),
+pitch (IMU), track currents and slips; the mode manager sees water contact (wet
+when the sensor point is under the surface), a valid depth deeper than the
+sounder's minimum, the weight on the tracks and the track force (current x gain),
+at the drivers' 20 Hz. All from dukw_sim's Truth, not yet through the sensor
+models and the EKF.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from dukw_common.config import node_params
+from dukw_control import controller, modes
+from dukw_control.controller import ControllerSettings, DriveController
+from dukw_control.modes import ModeManager, ModeSettings
+from dukw_sim.core import Actuation, SimCore
+from dukw_sim.truth import Truth
+
+STATUS_EVERY = 5          # 100 Hz / 5 = the motor controllers' and mode manager's 20 Hz
+
+
+def default_controller_settings() -> ControllerSettings:
+    return controller.settings_from_params(node_params('drive_controller_node'))
+
+
+def default_mode_settings() -> ModeSettings:
+    return modes.settings_from_params(node_params('mode_manager_node'))
+
+
+@dataclass
+class Record:
+    """What happened, one entry per 0.01 s step."""
+
+    truth: list[Truth] = field(default_factory=list)
+    tracks: list[tuple[float, float]] = field(default_factory=list)
+    props: list[tuple[float, float]] = field(default_factory=list)
+    modes: list[tuple[float, modes.Mode, str]] = field(default_factory=list)
+
+
+class ClosedLoop:
+    """SimCore + ModeManager + DriveController, stepped together at 100 Hz."""
+
+    def __init__(self, sim_overrides=None, seed: int = 0, start: str = 'sand',
+                 x_m: float | None = None, yaw_rad: float = 0.0,
+                 controller_settings: ControllerSettings | None = None,
+                 mode_settings: ModeSettings | None = None) -> None:
+        self.sim = SimCore.from_config(overrides=sim_overrides or {}, seed=seed)
+        self.truth = self.sim.reset(start, x_m, yaw_rad)
+        self.ctrl = DriveController(controller_settings or default_controller_settings())
+        self.modes = ModeManager(mode_settings or default_mode_settings())
+        self.gain = self.sim.vehicle.drivetrain.track_force_gain_n_per_a
+        self.min_depth_m = self.sim.vehicle.sensors.depth_sounder_min_m
+        self.authority = True
+        self.ctrl.on_authority(True, 'computer', 0.0)
+        self.k = 0
+        self.record = Record()
+
+    def set_authority(self, usable: bool) -> None:
+        """The operator takes over (False) or gives the vehicle back (True)."""
+        self.ctrl.on_authority(usable, 'computer' if usable else 'RC operator',
+                               self.truth.t_s)
+
+    def step(self, cmd: tuple[float, float] | None) -> Truth:
+        """One 0.01 s cycle; ``cmd`` is a cmd_vel (v, w) arriving now, or None."""
+        tr, c, t = self.truth, self.ctrl, self.truth.t_s
+        if cmd is not None:
+            c.on_cmd_vel(*cmd, t)
+        c.on_odometry(tr.surge_mps, tr.yaw_rate_rps, t)
+        c.on_pitch(tr.pitch_rad, t)
+        c.on_slips(tr.port_slip, tr.stbd_slip, t)
+        if self.k % STATUS_EVERY == 0:
+            c.on_track_currents(tr.port_current_a, tr.stbd_current_a, t)
+            m = self.modes
+            m.on_water_contact(tr.fore_sensor_depth_m > 0.0, tr.aft_sensor_depth_m > 0.0, t)
+            m.on_depth(tr.sounder_depth_m > self.min_depth_m, tr.sounder_depth_m, t)
+            m.on_traction(tr.weight_on_tracks_fraction, t)
+            m.on_track_forces(tr.port_current_a * self.gain, tr.stbd_current_a * self.gain, t)
+            decision = m.update(t)
+            if m.changed:
+                m.changed = False
+                c.on_mode(decision)
+                self.record.modes.append((t, decision.mode, decision.reason))
+        out = c.step(t)
+        self.k += 1
+        self.truth = self.sim.step(Actuation(out.tracks.port, out.tracks.stbd,
+                                             out.props.port, out.props.stbd))
+        rec = self.record
+        rec.truth.append(self.truth)
+        rec.tracks.append((out.tracks.port, out.tracks.stbd))
+        rec.props.append((out.props.port, out.props.stbd))
+        return self.truth
+
+    def run(self, seconds: float, cmd: tuple[float, float] | None = (1.0, 0.0),
+            until=None) -> Truth:
+        """Step for ``seconds`` with a cmd_vel every cycle (None: none), or until ``until``."""
+        for _ in range(int(round(seconds / self.sim.dt_s))):
+            tr = self.step(cmd)
+            if until is not None and until(tr):
+                break
+        return self.truth
