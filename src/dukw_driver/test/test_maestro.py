@@ -49,10 +49,12 @@ def test_percent_to_pulse_with_end_points_dead_band_and_reversal():
         OutputChannel('port_track', 0, neutral_us=2100)
 
 
+PARAMS = node_params('servo_switch_node')
+CONFIG = switch_config(PARAMS)
+
+
 def params(**overrides):
-    p = node_params('servo_switch_node')
-    p.update(overrides)
-    return p
+    return {**PARAMS, **overrides}
 
 
 def test_switch_config_from_the_parameter_file_and_bad_values():
@@ -67,7 +69,7 @@ def test_switch_config_from_the_parameter_file_and_bad_values():
 
 
 def make_switch():
-    return ServoSwitch(switch_config(params()), command_timeout_s=0.5)
+    return ServoSwitch(CONFIG, command_timeout_s=0.5)
 
 
 def run(switch, maestro, t0, t1, dt=0.02):
