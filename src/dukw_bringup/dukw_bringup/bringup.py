@@ -195,7 +195,7 @@ class Runner:
         if self.log_dir is not None:
             self.log_dir.mkdir(parents=True, exist_ok=True)
         try:
-            for spec, command in zip(self.stack.nodes, commands):
+            for spec, command in zip(self.stack.nodes, commands, strict=True):
                 self._spawn(spec, command)
         except OSError:
             self.stop()

@@ -117,7 +117,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(prog='main_job', description=__doc__.split('\n')[0])
     parser.add_argument('--out', type=Path, help='run folder (default runs/<UTC timestamp>)')
     parser.add_argument('--mission', type=Path, help='mission file (default config/mission.yaml)')
-    parser.add_argument('--params-file', type=Path, help='parameter file (default config/dukw.yaml)')
+    parser.add_argument('--params-file', type=Path,
+                        help='parameter file (default config/dukw.yaml)')
     parser.add_argument('--stack', default='sim', help='stack name or file (default sim)')
     parser.add_argument('--rtf', type=float, default=1.0,
                         help='real-time factor of the simulator (0 = as fast as possible)')

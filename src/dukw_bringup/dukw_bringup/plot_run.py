@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from dukw_bringup.bag_io import BagError
+from dukw_bringup.bag_io import BagError, summarize
 from dukw_bringup.mission import MissionSpec, load_mission
 from dukw_bringup.plots import PlotContext, write_plots
 from dukw_bringup.summary import load_run, summarize_run, summary_lines, write_summary
@@ -50,7 +50,10 @@ def render_run(run_dir: str | Path, wall_time_s: float | None = None,
     limit_a = vehicle.drivetrain.continuous_current_limit_a
     summary = summarize_run(run, limit_a, mission.name, wall_time_s)
     summary.update(extra or {})
+    info = summarize(run_dir / BAG_DIR)
     summary['bag'] = BAG_DIR
+    summary['bag_messages'] = info.message_count
+    summary['bag_topics'] = {t.topic: t.count for t in info.topics}
     context = PlotContext(
         beach_slope_rad=vehicle.site.beach_slope_rad,
         sea_floor_depth_m=vehicle.site.sea_floor_depth_m,

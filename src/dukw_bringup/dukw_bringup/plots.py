@@ -59,9 +59,9 @@ def _save(fig, path: Path) -> Path:
     return path
 
 
-def _legend(ax) -> None:
+def _legend(ax, loc: str = 'upper right') -> None:
     if ax.get_legend_handles_labels()[0]:
-        ax.legend(loc='upper right', fontsize='small')
+        ax.legend(loc=loc, fontsize='small')
 
 
 def _no_data(ax, what: str) -> None:
@@ -91,7 +91,7 @@ def plot_trajectory(run: RunData, ctx: PlotContext, path: Path) -> Path:
     plan.set_xlabel('x seaward (m)')
     plan.set_ylabel('y (m)')
     plan.set_aspect('equal', adjustable='datalim')
-    _legend(plan)
+    _legend(plan, 'center')
     if xs:
         finite = np.concatenate(xs)
         finite = finite[np.isfinite(finite)]
@@ -149,7 +149,7 @@ def plot_forces(run: RunData, ctx: PlotContext, path: Path) -> Path:
 def plot_slip(run: RunData, ctx: PlotContext, path: Path) -> Path:
     """Slip per track: estimated (traction) and true (sim/truth)."""
     fig, axes = _figure(2, ctx.title or 'track slip')
-    for ax, side in zip(axes, ('port', 'stbd')):
+    for ax, side in zip(axes, ('port', 'stbd'), strict=True):
         plotted = False
         for topic, label, style in (('traction', 'estimated', '-'), ('sim/truth', 'truth', '--')):
             series = run.get(topic)
@@ -229,4 +229,4 @@ def write_plots(run: RunData, ctx: PlotContext, out_dir: str | Path) -> list[Pat
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     makers = (plot_trajectory, plot_forces, plot_slip, plot_submersion, plot_modes)
-    return [make(run, ctx, out / name) for make, name in zip(makers, PLOT_FILES)]
+    return [make(run, ctx, out / name) for make, name in zip(makers, PLOT_FILES, strict=True)]

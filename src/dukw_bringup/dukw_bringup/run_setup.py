@@ -82,7 +82,7 @@ def write_overlay(path: Path, stack: StackSpec, spec: MissionSpec, mission_file:
             doc[name] = {'ros__parameters': {'use_sim_time': True}}
     if 'mission_node' in doc:
         doc['mission_node']['ros__parameters']['mission_file'] = str(mission_file)
-    path.write_text('# The run\'s overrides of dukw.yaml (written by main_job).\n'
+    path.write_text("# The run's overrides of dukw.yaml (written by main_job).\n"
                     + yaml.safe_dump(doc, sort_keys=False))
     return path
 

@@ -77,8 +77,8 @@ class RunData:
 
     series: dict[str, Series] = field(default_factory=dict)
     texts: dict[str, list[tuple[float, str]]] = field(default_factory=dict)
-    duration_s: float = 0.0
-    message_count: int = 0
+    duration_s: float = 0.0      # first to last message of the topics read
+    message_count: int = 0       # messages of the topics read
 
     def get(self, topic: str) -> Series | None:
         """The topic's series, or None when the bag has no message of it."""
@@ -94,14 +94,12 @@ def load_run(bag_path: str | Path) -> RunData:
     t0_ns: int | None = None
     count = 0
     last_ns = 0
-    for message in read_messages(bag_path):
+    for message in read_messages(bag_path, [*COLUMNS, *TEXT_TOPICS]):
         count += 1
         if t0_ns is None and message.timestamp_ns > 0:
             t0_ns = message.timestamp_ns  # a sim-time recorder stamps 0 before the first /clock
         last_ns = message.timestamp_ns
         key = topic_key(message.topic)
-        if key not in COLUMNS and key not in TEXT_TOPICS:
-            continue
         msg = deserialize(message)
         t_s = max(0.0, (message.timestamp_ns - (t0_ns or message.timestamp_ns)) * 1e-9)
         if key in COLUMNS:
@@ -126,7 +124,7 @@ def mode_timeline(run: RunData) -> list[dict[str, Any]]:
     if series is None:
         return timeline
     previous = None
-    for t_s, mode in zip(series.t_s, series['mode']):
+    for t_s, mode in zip(series.t_s, series['mode'], strict=True):
         if mode != previous:
             timeline.append({'t_s': round(float(t_s), 3),
                              'mode': MODE_NAMES.get(int(mode), str(int(mode))),
@@ -200,7 +198,6 @@ def summarize_run(run: RunData, current_limit_a: float,
         'waypoint_times_s': [round(t, 2) for t in progress.reached_s] if progress else [],
         'recorded_s': round(run.duration_s, 2),
         'wall_time_s': None if wall_time_s is None else round(wall_time_s, 2),
-        'messages': run.message_count,
         'mode_timeline': mode_timeline(run),
         'current_limit_a': current_limit_a,
         'track_currents': current_figures(run.get('tracks/status'), current_limit_a),

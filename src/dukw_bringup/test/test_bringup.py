@@ -77,6 +77,14 @@ class Bringup:
         return self.proc.returncode, out, err
 
 
+def wait_in_graph(names, timeout_s: float = 30.0) -> bool:
+    """True once every node in ``names`` is on the ROS graph (up, signal handlers set)."""
+    from dukw_common.testing import ros_node, spin_until
+    with ros_node('bringup_probe') as (probe, executor):
+        return spin_until(executor, lambda: set(names) <= set(probe.get_node_names()),
+                          timeout_s)
+
+
 def alive(pid: int) -> bool:
     try:
         os.kill(pid, 0)
@@ -93,7 +101,7 @@ def test_a_node_that_dies_stops_the_stack_with_an_error(tmp_path):
     runner = Bringup(stack)
     pids = runner.wait_started(2)
     assert set(pids) == {'sim_node', 'mission_node'}
-    time.sleep(2.0)
+    assert wait_in_graph(pids)
     os.kill(pids['sim_node'], signal.SIGKILL)
     code, _, err = runner.finish()
     assert code == 1
@@ -108,7 +116,7 @@ def test_ctrl_c_stops_every_node_in_reverse_order_and_exits_0(tmp_path):
     stack.write_text(SMALL_STACK)
     runner = Bringup(stack, '--log-dir', str(tmp_path / 'logs'), '--quiet')
     pids = runner.wait_started(2)
-    time.sleep(2.0)
+    assert wait_in_graph(pids)
     runner.proc.send_signal(signal.SIGINT)
     code, out, err = runner.finish()
     assert code == 0, err

@@ -97,6 +97,7 @@ def test_plot_run_writes_summary_and_every_plot(tmp_path, capsys):
     summary = json.loads((tmp_path / 'summary.json').read_text())
     for key in ('reached', 'time_s', 'mode_timeline', 'track_currents', 'slip', 'submersion'):
         assert key in summary
+    assert summary['bag_topics']['/tracks/status'] == 201
     for name in PLOT_FILES:
         png = (tmp_path / name).read_bytes()
         assert png.startswith(b'\x89PNG') and len(png) > 10_000, name
