@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from typing import Callable, Sequence
 
 import rclpy
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.executors import Executor, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy,
@@ -94,12 +94,14 @@ def parameter_overrides(overrides: dict[str, ParamValue]) -> list[Parameter]:
     return [Parameter(k, value=v) for k, v in overrides.items()]
 
 
-def run_node(factory: Callable[[], Node], args: list[str] | None = None) -> int:
+def run_node(factory: Callable[[], Node], args: list[str] | None = None,
+             executor_factory: Callable[[], Executor] = SingleThreadedExecutor) -> int:
     """Run one node until SIGINT/SIGTERM, then let it stop safely and exit 0.
 
     The node may define ``on_shutdown()``: it runs while the context is still up,
     so it can publish a last neutral command. A ConfigError at construction
-    prints a clear message and exits 2.
+    prints a clear message and exits 2. ``executor_factory`` may give another
+    executor (e.g. rclpy.experimental.EventsExecutor; it is spun with a timeout).
     """
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     stop = threading.Event()
@@ -109,7 +111,7 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None) -> int:
     code = 0
     try:
         node = factory()
-        executor = SingleThreadedExecutor()
+        executor = executor_factory()
         executor.add_node(node)
         while not stop.is_set() and rclpy.ok():
             executor.spin_once(timeout_sec=0.05)

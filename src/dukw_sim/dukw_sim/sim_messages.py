@@ -1,31 +1,44 @@
 """ROS messages from the simulator's readings (sensors.py, switch.py, truth.py).
 
-The only dukw_sim module besides sim_node that knows message types. Every
-builder takes the stamp as sim time in seconds. Messages are built anew each
-call (publishing serialises at once, so reuse would also be safe, but the
-gain measured small against DDS).
+The only dukw_sim module besides sim_node that knows message types. Each topic
+has one message object that is updated in place and returned: publishing
+serialises at once, and setting fields costs a tenth of building a message
+(constant covariances and frame ids are set once). A caller that keeps a
+returned message beyond the next call of the same builder must copy it.
+Stamps are sim time.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from builtin_interfaces.msg import Time
+from diagnostic_msgs.msg import DiagnosticArray
 from dukw_msgs.msg import Authority, Depth, DrivetrainStatus, MotorSide, RcInput, SimTruth
 from dukw_msgs.msg import WaterContact
 from geometry_msgs.msg import TwistWithCovarianceStamped
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, NavSatFix, NavSatStatus
-from std_msgs.msg import Header
 
+from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS
 from dukw_driver.authority import AuthorityState
 from dukw_sim.sensors import (DepthReading, DrivetrainReading, Fault, GpsFix, GpsVelocity,
                               ImuReading, MotorReading, WaterContactReading)
 from dukw_sim.switch import RcReading
 from dukw_sim.truth import Truth
 
+#: What sim_node publishes: the drivers' topic contract (architecture.md) plus sim/truth, /clock.
+TOPICS = [('imu/data', Imu, SENSOR_QOS), ('gps/fix', NavSatFix, SENSOR_QOS),
+          ('gps/vel', TwistWithCovarianceStamped, SENSOR_QOS),
+          ('water/contact', WaterContact, SENSOR_QOS), ('depth', Depth, SENSOR_QOS),
+          ('tracks/status', DrivetrainStatus, SENSOR_QOS),
+          ('props/status', DrivetrainStatus, SENSOR_QOS), ('rc/input', RcInput, SENSOR_QOS),
+          ('authority', Authority, STATE_QOS), ('sim/truth', SimTruth, SENSOR_QOS),
+          ('/clock', Clock, COMMAND_QOS), ('/diagnostics', DiagnosticArray, COMMAND_QOS)]
 #: A variance that says "not measured" in a covariance the message must fill.
 UNMEASURED_VAR = 1e6
-_FAULT_NAMES = {int(flag): name.lower() for name, flag in Fault.__members__.items()}
+_FAULT_NAMES = [(int(flag), name.lower()) for name, flag in Fault.__members__.items()]
+#: SimTruth fields copied from Truth fields of the same name.
+_TRUTH_FIELDS = [f for f in SimTruth.get_fields_and_field_types()
+                 if f not in ('header', 'medium') and f in Truth.__dataclass_fields__]
 
 
 @dataclass(frozen=True)
@@ -35,120 +48,165 @@ class Frames:
     base: str
     imu: str
     gps: str
+    odom: str = 'odom'
 
 
-def stamp(t_s: float) -> Time:
-    """Sim time in seconds -> builtin_interfaces/Time."""
-    ns = int(round(t_s * 1e9))
-    return Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
+def set_time(time_msg, t_s: float) -> None:
+    """Write ``t_s`` seconds into a builtin_interfaces/Time in place."""
+    time_msg.sec, time_msg.nanosec = divmod(int(round(t_s * 1e9)), 1_000_000_000)
+
+
+def set_stamp(header, t_s: float) -> None:
+    """Write sim time ``t_s`` (seconds) into ``header.stamp``."""
+    set_time(header.stamp, t_s)
 
 
 def _diag3(var: tuple) -> list[float]:
     return [var[0], 0.0, 0.0, 0.0, var[1], 0.0, 0.0, 0.0, var[2]]
 
 
-def imu(r: ImuReading, frames: Frames) -> Imu:
-    """sensor_msgs/Imu: orientation ENU (REP 145), rates and specific force in imu_link (FLU)."""
-    msg = Imu()
-    msg.header.stamp = stamp(r.t_s)
-    msg.header.frame_id = frames.imu
-    q = msg.orientation
-    q.x, q.y, q.z, q.w = r.orientation_xyzw
-    w = msg.angular_velocity
-    w.x, w.y, w.z = r.angular_velocity_rps
-    a = msg.linear_acceleration
-    a.x, a.y, a.z = r.linear_acceleration_mps2
-    msg.orientation_covariance = _diag3(r.orientation_var)
-    msg.angular_velocity_covariance = _diag3(r.angular_velocity_var)
-    msg.linear_acceleration_covariance = _diag3(r.linear_acceleration_var)
-    return msg
-
-
-def gps_fix(r: GpsFix, frames: Frames) -> NavSatFix:
-    """sensor_msgs/NavSatFix: a differential (GBAS) GPS fix with a known diagonal covariance."""
-    msg = NavSatFix()
-    msg.header.stamp = stamp(r.t_s)
-    msg.header.frame_id = frames.gps
-    msg.status.status = NavSatStatus.STATUS_GBAS_FIX
-    msg.status.service = NavSatStatus.SERVICE_GPS
-    msg.latitude, msg.longitude, msg.altitude = r.latitude_deg, r.longitude_deg, r.altitude_m
-    msg.position_covariance = _diag3(r.position_var)
-    msg.position_covariance_type = NavSatFix.COVARIANCE_TYPE_DIAGONAL_KNOWN
-    return msg
-
-
-def gps_velocity(r: GpsVelocity, frames: Frames) -> TwistWithCovarianceStamped:
-    """geometry_msgs/TwistWithCovarianceStamped: linear = ENU velocity of the antenna."""
-    msg = TwistWithCovarianceStamped()
-    msg.header.stamp = stamp(r.t_s)
-    msg.header.frame_id = frames.gps
-    v = msg.twist.twist.linear
-    v.x, v.y, v.z = r.velocity_enu_mps
-    cov = [0.0] * 36
-    cov[0], cov[7], cov[14] = r.velocity_var
-    cov[21] = cov[28] = cov[35] = UNMEASURED_VAR
-    msg.twist.covariance = cov
-    return msg
-
-
-def water_contact(r: WaterContactReading, frames: Frames) -> WaterContact:
-    """dukw_msgs/WaterContact (the sensor points are config sensors.* in base_link)."""
-    return WaterContact(header=_header(r.t_s, frames.base), fore_wet=r.fore_wet, aft_wet=r.aft_wet,
-                        fore_level=r.fore_level, aft_level=r.aft_level)
-
-
-def depth(r: DepthReading, frames: Frames) -> Depth:
-    """dukw_msgs/Depth."""
-    return Depth(header=_header(r.t_s, frames.base), valid=r.valid, depth_m=r.depth_m,
-                 offset_m=r.offset_m, water_temp_c=r.water_temp_c)
-
-
-def _side(m: MotorReading) -> MotorSide:
+def _fill_side(side: MotorSide, m: MotorReading) -> None:
     flags = int(m.fault_flags)
-    return MotorSide(command_pct=m.command_pct, current_a=m.current_a, voltage_v=m.voltage_v,
-                     speed_mps=m.speed_mps, force_n=m.force_n, temperature_c=m.temperature_c,
-                     fault_flags=flags,
-                     faults=[name for bit, name in _FAULT_NAMES.items() if flags & bit])
+    side.command_pct, side.current_a, side.voltage_v = m.command_pct, m.current_a, m.voltage_v
+    side.speed_mps, side.force_n, side.temperature_c = m.speed_mps, m.force_n, m.temperature_c
+    if flags != side.fault_flags or (flags and not side.faults):
+        side.fault_flags = flags
+        side.faults = [name for bit, name in _FAULT_NAMES if flags & bit]
 
 
-def drivetrain(r: DrivetrainReading, frames: Frames) -> DrivetrainStatus:
-    """dukw_msgs/DrivetrainStatus for tracks/status or props/status."""
-    drive = DrivetrainStatus.DRIVE_TRACKS if r.drive == 'tracks' else (
-        DrivetrainStatus.DRIVE_PROPELLERS)
-    return DrivetrainStatus(header=_header(r.t_s, frames.base), drive=drive,
-                            connected=r.connected, port=_side(r.port), stbd=_side(r.stbd))
+class SimMessages:
+    """One in-place message per topic, filled from the simulator's dataclasses."""
 
+    def __init__(self, frames: Frames) -> None:
+        self.frames = frames
+        self._imu = Imu()
+        self._imu.header.frame_id = frames.imu
+        self._imu_var: tuple | None = None
+        self._fix = NavSatFix(status=NavSatStatus(status=NavSatStatus.STATUS_GBAS_FIX,
+                                                  service=NavSatStatus.SERVICE_GPS),
+                              position_covariance_type=NavSatFix.COVARIANCE_TYPE_DIAGONAL_KNOWN)
+        self._fix.header.frame_id = frames.gps
+        self._fix_var: tuple | None = None
+        self._vel = TwistWithCovarianceStamped()
+        self._vel.header.frame_id = frames.gps
+        self._vel_var: tuple | None = None
+        self._water = WaterContact()
+        self._water.header.frame_id = frames.base
+        self._depth = Depth()
+        self._depth.header.frame_id = frames.base
+        self._drives = {'tracks': DrivetrainStatus(drive=DrivetrainStatus.DRIVE_TRACKS),
+                        'props': DrivetrainStatus(drive=DrivetrainStatus.DRIVE_PROPELLERS)}
+        for msg in self._drives.values():
+            msg.header.frame_id = frames.base
+        self._rc = RcInput()
+        self._authority = Authority()
+        self._truth = SimTruth()
+        self._truth.header.frame_id = frames.odom
+        self._clock = Clock()
+        self._by_type = {ImuReading: ('imu/data', self.imu), GpsFix: ('gps/fix', self.gps_fix),
+                         GpsVelocity: ('gps/vel', self.gps_velocity),
+                         WaterContactReading: ('water/contact', self.water_contact),
+                         DepthReading: ('depth', self.depth)}
 
-def rc_input(r: RcReading) -> RcInput:
-    """dukw_msgs/RcInput."""
-    return RcInput(header=_header(r.t_s, ''), link_ok=r.link_ok, rc_selected=r.rc_selected,
-                   channels_us=list(r.channels_us))
+    def reading(self, r) -> tuple[str, object]:
+        """(topic, message) for any reading SensorModel.sample gives."""
+        if isinstance(r, DrivetrainReading):
+            return f'{r.drive}/status', self.drivetrain(r)
+        topic, build = self._by_type[type(r)]
+        return topic, build(r)
 
+    def imu(self, r: ImuReading) -> Imu:
+        """sensor_msgs/Imu: orientation ENU (REP 145), rates and specific force in imu_link."""
+        msg = self._imu
+        set_stamp(msg.header, r.t_s)
+        q, w, a = msg.orientation, msg.angular_velocity, msg.linear_acceleration
+        q.x, q.y, q.z, q.w = r.orientation_xyzw
+        w.x, w.y, w.z = r.angular_velocity_rps
+        a.x, a.y, a.z = r.linear_acceleration_mps2
+        var = (r.orientation_var, r.angular_velocity_var, r.linear_acceleration_var)
+        if var != self._imu_var:
+            self._imu_var = var
+            msg.orientation_covariance = _diag3(r.orientation_var)
+            msg.angular_velocity_covariance = _diag3(r.angular_velocity_var)
+            msg.linear_acceleration_covariance = _diag3(r.linear_acceleration_var)
+        return msg
 
-def authority(state: AuthorityState, t_s: float) -> Authority:
-    """dukw_msgs/Authority from the CommandGate's state."""
-    return Authority(header=_header(t_s, ''), holder=int(state.holder),
-                     reason=int(state.reason), rc_link_ok=state.rc_link_ok,
-                     outputs_neutral=state.outputs_neutral, detail=state.detail)
+    def gps_fix(self, r: GpsFix) -> NavSatFix:
+        """sensor_msgs/NavSatFix: a differential (GBAS) fix, known diagonal covariance (ENU)."""
+        msg = self._fix
+        set_stamp(msg.header, r.t_s)
+        msg.latitude, msg.longitude, msg.altitude = r.latitude_deg, r.longitude_deg, r.altitude_m
+        if r.position_var != self._fix_var:
+            self._fix_var = r.position_var
+            msg.position_covariance = _diag3(r.position_var)
+        return msg
 
+    def gps_velocity(self, r: GpsVelocity) -> TwistWithCovarianceStamped:
+        """geometry_msgs/TwistWithCovarianceStamped: linear = the antenna's ENU velocity."""
+        msg = self._vel
+        set_stamp(msg.header, r.t_s)
+        v = msg.twist.twist.linear
+        v.x, v.y, v.z = r.velocity_enu_mps
+        if r.velocity_var != self._vel_var:
+            self._vel_var = r.velocity_var
+            cov = [0.0] * 36
+            cov[0], cov[7], cov[14] = r.velocity_var
+            cov[21] = cov[28] = cov[35] = UNMEASURED_VAR
+            msg.twist.covariance = cov
+        return msg
 
-def sim_truth(t: Truth, frame_id: str = 'odom') -> SimTruth:
-    """dukw_msgs/SimTruth: pose in odom, body velocities, traction and world at the vehicle."""
-    return SimTruth(
-        header=_header(t.t_s, frame_id), x_m=t.x_m, y_m=t.y_m, z_m=t.z_m, yaw_rad=t.yaw_rad,
-        roll_rad=t.roll_rad, pitch_rad=t.pitch_rad, surge_mps=t.surge_mps, sway_mps=t.sway_mps,
-        yaw_rate_rps=t.yaw_rate_rps, heave_mps=t.heave_mps, port_slip=t.port_slip,
-        stbd_slip=t.stbd_slip, port_force_n=t.port_force_n, stbd_force_n=t.stbd_force_n,
-        submerged_volume_m3=t.submerged_volume_m3, effective_weight_n=t.effective_weight_n,
-        weight_on_tracks_fraction=t.weight_on_tracks_fraction,
-        waterline_distance_m=t.waterline_distance_m, water_depth_m=t.water_depth_m,
-        wave_elevation_m=t.wave_elevation_m, medium=int(t.medium))
+    def water_contact(self, r: WaterContactReading) -> WaterContact:
+        """dukw_msgs/WaterContact (the sensor points are config sensors.* in base_link)."""
+        msg = self._water
+        set_stamp(msg.header, r.t_s)
+        msg.fore_wet, msg.aft_wet = r.fore_wet, r.aft_wet
+        msg.fore_level, msg.aft_level = r.fore_level, r.aft_level
+        return msg
 
+    def depth(self, r: DepthReading) -> Depth:
+        """dukw_msgs/Depth."""
+        msg = self._depth
+        set_stamp(msg.header, r.t_s)
+        msg.valid, msg.depth_m = r.valid, r.depth_m
+        msg.offset_m, msg.water_temp_c = r.offset_m, r.water_temp_c
+        return msg
 
-def clock(t_s: float) -> Clock:
-    """rosgraph_msgs/Clock."""
-    return Clock(clock=stamp(t_s))
+    def drivetrain(self, r: DrivetrainReading) -> DrivetrainStatus:
+        """dukw_msgs/DrivetrainStatus for tracks/status or props/status."""
+        msg = self._drives[r.drive]
+        set_stamp(msg.header, r.t_s)
+        msg.connected = r.connected
+        _fill_side(msg.port, r.port)
+        _fill_side(msg.stbd, r.stbd)
+        return msg
 
+    def rc_input(self, r: RcReading) -> RcInput:
+        """dukw_msgs/RcInput."""
+        msg = self._rc
+        set_stamp(msg.header, r.t_s)
+        msg.link_ok, msg.rc_selected = r.link_ok, r.rc_selected
+        msg.channels_us = list(r.channels_us)
+        return msg
 
-def _header(t_s: float, frame_id: str) -> Header:
-    return Header(stamp=stamp(t_s), frame_id=frame_id)
+    def authority(self, state: AuthorityState, t_s: float) -> Authority:
+        """dukw_msgs/Authority from the CommandGate's state."""
+        msg = self._authority
+        set_stamp(msg.header, t_s)
+        msg.holder, msg.reason = int(state.holder), int(state.reason)
+        msg.rc_link_ok, msg.outputs_neutral = state.rc_link_ok, state.outputs_neutral
+        msg.detail = state.detail
+        return msg
+
+    def sim_truth(self, t: Truth) -> SimTruth:
+        """dukw_msgs/SimTruth: pose in odom, body velocities, traction, world at the vehicle."""
+        msg = self._truth
+        set_stamp(msg.header, t.t_s)
+        for name in _TRUTH_FIELDS:
+            setattr(msg, name, float(getattr(t, name)))
+        msg.medium = int(t.medium)
+        return msg
+
+    def clock(self, t_s: float) -> Clock:
+        """rosgraph_msgs/Clock."""
+        set_time(self._clock.clock, t_s)
+        return self._clock

@@ -29,6 +29,8 @@ _OWN = [
               '(sim time), s', min=0.01, max=10.0),
     ParamSpec('max_steps_per_tick', 'physics steps one timer tick may run to catch up with the '
               'wall clock', min=1, max=100000),
+    ParamSpec('max_lag_s', 'sim seconds the simulator may fall behind wall clock x '
+              'real_time_factor before it stops catching up', min=0.01, max=100.0),
     ParamSpec('frames.base', 'frame_id of the vehicle (base_link)'),
     ParamSpec('frames.imu', 'frame_id of imu/data: (0, 0, sensors.imu_z_m) in base_link'),
     ParamSpec('frames.gps', 'frame_id of gps/fix and gps/vel: (0, 0, sensors.gps_antenna_z_m)'),

@@ -1,0 +1,145 @@
+"""sim_node's ROS-free pacing and health, and its message builders (no DDS)."""
+import math
+
+import pytest
+from dukw_msgs.msg import Authority, DrivetrainStatus, MotorSide, SimTruth
+
+from dukw_common.diagnostics import Level
+from dukw_driver.authority import AuthorityState, Holder, Reason
+from dukw_sim.runtime import Pacer, SpeedMeter, sim_healths
+from dukw_sim.sensors import (DepthReading, DrivetrainReading, Fault, GpsFix, GpsVelocity,
+                              ImuReading, MotorReading, WaterContactReading)
+from dukw_sim.sim_messages import TOPICS, Frames, SimMessages
+from dukw_sim.switch import RcReading
+from dukw_sim.truth import Medium, Truth
+
+DT = 0.01
+
+
+def pacer(rtf, **kw):
+    args = {'steps_per_tick': 1, 'max_steps_per_tick': 20, 'max_lag_s': 0.5, 'wall_s': 100.0}
+    return Pacer(rtf, DT, **{**args, **kw})
+
+
+def test_pacer_follows_the_wall_clock_times_the_factor():
+    p = pacer(10.0)
+    assert p.period_s == pytest.approx(0.001)
+    steps = sum(p.steps_due(100.0 + k * 0.001) for k in range(1, 1001))
+    assert steps == pytest.approx(1000, abs=1)      # 1 s of wall = 10 s of sim = 1000 steps
+    assert p.dropped_s == 0.0
+
+
+def test_pacer_catches_up_a_late_tick_over_several_ticks_but_not_beyond_max_lag():
+    p = pacer(1.0)
+    assert p.steps_due(100.15) == 15                # 150 ms late: caught up at once
+    assert p.steps_due(100.45) == 20                # 30 steps owed, 20 per tick at most
+    assert p.steps_due(100.45) == 10
+    assert p.steps_due(103.0) == 20                 # 2.55 s behind: all but 0.5 s dropped
+    assert p.dropped_s == pytest.approx(2.05, abs=0.011)
+    assert sum(p.steps_due(103.0) for _ in range(5)) == 30
+    assert p.steps_due(103.0) == 0
+
+
+def test_pacer_as_fast_as_possible_runs_fixed_batches():
+    p = pacer(0.0, steps_per_tick=3)
+    assert p.period_s == 0.0
+    assert [p.steps_due(w) for w in (100.0, 100.0, 500.0)] == [3, 3, 3]
+
+
+@pytest.mark.parametrize('rtf', [-1.0, math.nan])
+def test_pacer_refuses_a_bad_factor(rtf):
+    with pytest.raises(ValueError):
+        pacer(rtf)
+
+
+def test_speed_meter_and_healths():
+    meter = SpeedMeter(wall_s=10.0, sim_s=0.0)
+    rates = meter.report(12.0, 10.0, {'imu/data': 1000, 'gps/fix': 100})
+    assert meter.achieved_rtf == pytest.approx(5.0)
+    assert rates == {'imu/data': 100.0, 'gps/fix': 10.0}
+    assert meter.report(12.0, 10.0, {'imu/data': 1000}) == {}
+    state = AuthorityState(Holder.NONE, Reason.RC_LINK_LOST, False, True, 'RC link lost')
+    sim, auth, topics = sim_healths(10.0, 10.0, meter, 0.0, {'steps': 1000}, state, 2, 3,
+                                    {'imu/data': 100.0})
+    assert sim.level == Level.WARN and '5.00x' in sim.message   # asked 10x, got 5x
+    assert auth.level == Level.WARN and auth.values['rejected_commands'] == 2
+    assert auth.values['holder'] == 'NONE' and auth.values['reason'] == 'RC_LINK_LOST'
+    assert topics.values == {'imu/data': '100.0'}
+    computer = AuthorityState(Holder.COMPUTER, Reason.RC_SWITCH, True, False, 'computer')
+    ok = sim_healths(10.0, 0.0, meter, 0.0, {}, computer, 0, 0, {})
+    assert ok[0].level == Level.OK and ok[1].level == Level.OK   # 0 = as fast as possible
+
+
+FRAMES = Frames('base_link', 'imu_link', 'gps_link')
+
+
+def test_topics_are_the_contract_with_the_right_qos():
+    names = [t for t, _, _ in TOPICS]
+    assert len(names) == len(set(names)) == 12
+    assert all(not t.startswith('/') for t in names if t not in ('/clock', '/diagnostics'))
+    qos = {t: q for t, _, q in TOPICS}
+    assert qos['authority'].durability.name == 'TRANSIENT_LOCAL'
+    assert qos['imu/data'].reliability.name == 'BEST_EFFORT'
+
+
+def test_readings_become_messages_on_their_topics():
+    msgs = SimMessages(FRAMES)
+    imu = ImuReading(1.25, (0.0, 0.0, 0.6, 0.8), (1e-5, 1e-5, 7e-5), (0.1, 0.2, 0.3),
+                     (9e-6,) * 3, (0.0, 0.1, 9.8), (1e-4, 8.1e-5, 8.1e-5))
+    topic, msg = msgs.reading(imu)
+    assert topic == 'imu/data' and msg.header.frame_id == 'imu_link'
+    assert (msg.header.stamp.sec, msg.header.stamp.nanosec) == (1, 250_000_000)
+    assert (msg.orientation.z, msg.orientation.w, msg.angular_velocity.z) == (0.6, 0.8, 0.3)
+    assert list(msg.orientation_covariance) == [1e-5, 0, 0, 0, 1e-5, 0, 0, 0, 7e-5]
+    topic, fix = msgs.reading(GpsFix(2.0, 36.1, -75.7, 1.0, (0.09, 0.09, 0.36)))
+    assert topic == 'gps/fix' and fix.latitude == 36.1 and fix.position_covariance[8] == 0.36
+    assert fix.position_covariance_type == fix.COVARIANCE_TYPE_DIAGONAL_KNOWN
+    assert fix.status.status == fix.status.STATUS_GBAS_FIX
+    topic, vel = msgs.reading(GpsVelocity(2.0, (1.0, -0.5, 0.1), (0.0025,) * 3))
+    assert topic == 'gps/vel' and vel.twist.twist.linear.y == -0.5
+    assert vel.twist.covariance[7] == 0.0025 and vel.twist.covariance[35] > 1e3
+    topic, water = msgs.reading(WaterContactReading(2.0, True, False, 0.9, 0.1))
+    assert topic == 'water/contact' and water.fore_wet and not water.aft_wet
+    topic, depth = msgs.reading(DepthReading(2.0, False, math.nan, 0.0, 18.0))
+    assert topic == 'depth' and not depth.valid and math.isnan(depth.depth_m)
+
+
+def test_drivetrain_faults_are_decoded_to_names():
+    msgs = SimMessages(FRAMES)
+    side = MotorReading(100.0, 60.0, 23.0, 0.0, 489.6, 80.0, Fault.STALL | Fault.OVERHEAT)
+    ok = MotorReading(50.0, 10.0, 24.0, 1.0, 81.6, 30.0, Fault(0))
+    topic, msg = msgs.reading(DrivetrainReading(3.0, 'tracks', True, side, ok))
+    assert topic == 'tracks/status' and msg.drive == DrivetrainStatus.DRIVE_TRACKS
+    assert msg.port.fault_flags == MotorSide.FAULT_STALL | MotorSide.FAULT_OVERHEAT
+    assert sorted(msg.port.faults) == ['overheat', 'stall'] and list(msg.stbd.faults) == []
+    topic, msg = msgs.reading(DrivetrainReading(3.0, 'props', True, ok, ok))
+    assert topic == 'props/status' and msg.drive == DrivetrainStatus.DRIVE_PROPELLERS
+    # the same side clears its faults when they go
+    topic, msg = msgs.reading(DrivetrainReading(3.1, 'tracks', True, ok, ok))
+    assert msg.port.fault_flags == 0 and list(msg.port.faults) == []
+
+
+def test_sim_faults_have_the_message_bits():
+    for flag in Fault:
+        assert getattr(MotorSide, f'FAULT_{flag.name}') == int(flag)
+
+
+def test_every_sim_truth_field_is_filled_from_truth():
+    truth = Truth(**{name: float(k + 1) for k, name in enumerate(Truth.field_names())
+                     if name != 'medium'}, medium=Medium.WATER)
+    msg = SimMessages(FRAMES).sim_truth(truth)
+    for name in SimTruth.get_fields_and_field_types():
+        if name not in ('header', 'medium'):
+            assert getattr(msg, name) == getattr(truth, name), name
+    assert msg.medium == SimTruth.MEDIUM_WATER and msg.header.frame_id == 'odom'
+
+
+def test_rc_authority_and_clock_messages():
+    msgs = SimMessages(FRAMES)
+    rc = msgs.rc_input(RcReading(4.0, True, True, (1350.0, 1600.0)))
+    assert rc.rc_selected and list(rc.channels_us) == [1350.0, 1600.0]
+    state = AuthorityState(Holder.RC, Reason.RC_SWITCH, True, False, 'RC operator')
+    auth = msgs.authority(state, 4.0)
+    assert (auth.holder, auth.reason) == (Authority.HOLDER_RC, Authority.REASON_RC_SWITCH)
+    clock = msgs.clock(12.345)
+    assert (clock.clock.sec, clock.clock.nanosec) == (12, 345_000_000)
