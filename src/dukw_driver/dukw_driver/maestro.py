@@ -268,12 +268,11 @@ class ServoSwitch:
     def targets(self, outputs: dict[str, SideCommand]) -> bytes:
         """Set Target frames for every output."""
         frames = []
+        deadband = self.config.deadband_pct
         for actuator, (port, stbd) in self.config.outputs.items():
             cmd = outputs[actuator]
-            frames.append(encode_set_target(port.channel,
-                                            port.target_qus(cmd.port_pct, self.config.deadband_pct)))
-            frames.append(encode_set_target(stbd.channel,
-                                            stbd.target_qus(cmd.stbd_pct, self.config.deadband_pct)))
+            frames.append(encode_set_target(port.channel, port.target_qus(cmd.port_pct, deadband)))
+            frames.append(encode_set_target(stbd.channel, stbd.target_qus(cmd.stbd_pct, deadband)))
         return b''.join(frames)
 
     def neutral_frame(self) -> bytes:

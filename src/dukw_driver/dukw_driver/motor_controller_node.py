@@ -14,10 +14,10 @@ from rclpy.node import Node
 from std_msgs.msg import Header
 
 from dukw_common.diagnostics import Level
-from dukw_common.node_tools import (COMMAND_QOS, ParamSpec, declare_parameters,
+from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, ParamSpec, declare_parameters,
                                     diagnostic_array, run_node, vehicle_specs)
 from dukw_common.vehicle import drivetrain_params
-from dukw_driver.motors import Drive, MotorMonitor, SideStatus
+from dukw_driver.motors import UNKNOWN_SIDE, Drive, MotorMonitor, SideStatus
 from dukw_driver.roboteq import FAULT_FLAG_BITS, QUERIES
 from dukw_driver.serial_link import DeviceHealth, SerialLink
 
@@ -34,7 +34,7 @@ CONTROLLER_FAULTS = {name for _, name in FAULT_FLAG_BITS.values()}
 
 
 class MotorControllerNode(Node):
-    """Thin shell: parameters, the serial link, a timer, the status topic; logic in MotorMonitor."""
+    """Thin shell: parameters, serial link, timer, status topic; logic in MotorMonitor."""
 
     def __init__(self, **node_kwargs) -> None:
         super().__init__('motor_controller_node', **node_kwargs)
@@ -47,9 +47,9 @@ class MotorControllerNode(Node):
         name = self.drive.name.lower()
         self.health = DeviceHealth(f'{name} controller', stale_after_s=p['stale_after_s'],
                                    expected_rate_hz=p['rate_hz'] * len(QUERIES))
-        self.status_pub = self.create_publisher(DrivetrainStatus, f'{name}/status', COMMAND_QOS)
+        self.status_pub = self.create_publisher(DrivetrainStatus, f'{name}/status', SENSOR_QOS)
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
-        self.last: tuple[SideStatus, SideStatus] | None = None
+        self.last: tuple[SideStatus, SideStatus] = (UNKNOWN_SIDE, UNKNOWN_SIDE)
         self.create_timer(1.0 / p['rate_hz'], self.on_tick)
         self.create_timer(1.0, self.on_diagnostics)
 
@@ -89,7 +89,7 @@ class MotorControllerNode(Node):
         for warning in self.monitor.warnings():
             health.worsen(Level.WARN, warning)
         limit_a = self.drivetrain.continuous_current_limit_a
-        for label, side in zip(('port', 'stbd'), self.last or ()):
+        for label, side in zip(('port', 'stbd'), self.last, strict=True):
             health.values[f'{label}_faults'] = ','.join(side.faults)
             if not self.monitor.fresh(now):
                 continue

@@ -68,7 +68,7 @@ class SerialLink:
         self.bytes_out = 0
 
     def poll(self) -> bytes:
-        """Return the bytes available now (b'' if none or closed); reopen when the back-off allows."""
+        """Return the bytes available now (b'' if none or closed); reopen when back-off allows."""
         if self._device is None and not self._try_open():
             return b''
         try:

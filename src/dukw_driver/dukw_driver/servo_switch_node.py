@@ -13,8 +13,8 @@ from rclpy.node import Node
 from std_msgs.msg import Header
 
 from dukw_common.diagnostics import Level
-from dukw_common.node_tools import (COMMAND_QOS, STATE_QOS, ParamSpec, declare_parameters,
-                                    diagnostic_array, run_node)
+from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
+                                    declare_parameters, diagnostic_array, run_node)
 from dukw_driver.maestro import ServoSwitch, switch_config
 from dukw_driver.serial_link import DeviceHealth, SerialLink
 
@@ -65,7 +65,7 @@ class ServoSwitchNode(Node):
         self.rejected = 0
         self._authority_sent_s = -1e9
         self.authority_pub = self.create_publisher(Authority, 'authority', STATE_QOS)
-        self.rc_pub = self.create_publisher(RcInput, 'rc/input', COMMAND_QOS)
+        self.rc_pub = self.create_publisher(RcInput, 'rc/input', SENSOR_QOS)
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
         for actuator in self.switch.gate.ACTUATORS:
             self.create_subscription(DiffCommand, f'{actuator}/cmd',

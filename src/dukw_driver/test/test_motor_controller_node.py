@@ -6,7 +6,7 @@ import pytest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from dukw_msgs.msg import DrivetrainStatus, MotorSide
 
-from dukw_common.node_tools import COMMAND_QOS, parameter_overrides
+from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, parameter_overrides
 from dukw_common.testing import NodeProcess, ros_node, spin_until
 from dukw_driver.motor_controller_node import MotorControllerNode
 from fake_device import FakeDevice
@@ -33,7 +33,7 @@ class Graph:
         self.status: list[DrivetrainStatus] = []
         self.diagnostics: list[DiagnosticStatus] = []
         probe.create_subscription(DrivetrainStatus, f'{drive}/status', self.status.append,
-                                  COMMAND_QOS)
+                                  SENSOR_QOS)
         probe.create_subscription(DiagnosticArray, '/diagnostics',
                                   lambda m: self.diagnostics.extend(m.status), COMMAND_QOS)
 

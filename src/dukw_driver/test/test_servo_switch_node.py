@@ -5,7 +5,7 @@ import time
 import pytest
 from dukw_msgs.msg import Authority, DiffCommand, RcInput
 
-from dukw_common.node_tools import COMMAND_QOS, STATE_QOS, parameter_overrides
+from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS, parameter_overrides
 from dukw_common.testing import NodeProcess, ros_node, spin_until
 from dukw_driver.servo_switch_node import ServoSwitchNode
 from fake_device import FakeDevice
@@ -35,7 +35,7 @@ class Graph:
         self.authority: list[Authority] = []
         self.rc: list[RcInput] = []
         probe.create_subscription(Authority, 'authority', self.authority.append, STATE_QOS)
-        probe.create_subscription(RcInput, 'rc/input', self.rc.append, COMMAND_QOS)
+        probe.create_subscription(RcInput, 'rc/input', self.rc.append, SENSOR_QOS)
         self.tracks = probe.create_publisher(DiffCommand, 'tracks/cmd', COMMAND_QOS)
 
     def spin_until(self, predicate, timeout_s=5.0, command=None):
