@@ -34,8 +34,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any, Mapping, Sequence
 
-import yaml
 
+from dukw_bringup.yaml_file import read_yaml
 from dukw_common.config import ConfigError, default_config_path
 
 _NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')
@@ -103,12 +103,7 @@ def parse_stack(doc: Any, source: str = 'stack') -> StackSpec:
 def load_stack(path: str | Path) -> StackSpec:
     """Read a stack file; raise ConfigError if it is missing or malformed."""
     path = Path(path)
-    try:
-        doc = yaml.safe_load(path.read_text())
-    except OSError as exc:
-        raise ConfigError(f'cannot read stack file {path}: {exc.strerror}') from exc
-    except yaml.YAMLError as exc:
-        raise ConfigError(f'{path} is not valid YAML: {exc}') from exc
+    doc = read_yaml(path, 'stack file')
     return parse_stack(doc, str(path))
 
 

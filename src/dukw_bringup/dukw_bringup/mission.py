@@ -19,8 +19,8 @@ from enum import Enum
 from pathlib import Path
 from typing import Any, Mapping
 
-import yaml
 
+from dukw_bringup.yaml_file import read_yaml
 from dukw_common.config import ConfigError, default_config_path
 from dukw_common.geometry import wrap_angle
 
@@ -171,12 +171,7 @@ def default_mission_path() -> Path:
 def load_mission(path: str | Path | None = None) -> MissionSpec:
     """Read a mission file; raise ConfigError naming what is wrong."""
     path = Path(path) if path else default_mission_path()
-    try:
-        doc = yaml.safe_load(path.read_text())
-    except OSError as exc:
-        raise ConfigError(f'cannot read mission file {path}: {exc.strerror}') from exc
-    except yaml.YAMLError as exc:
-        raise ConfigError(f'{path} is not valid YAML: {exc}') from exc
+    doc = read_yaml(path, 'mission file')
     return parse_mission(doc)
 
 
