@@ -451,7 +451,7 @@ class SimCore:
         c, s = math.cos(self.yaw), math.sin(self.yaw)
         px, water, depths, areas = self._hydro()
         n = self._n_stations
-        eta = water.elevation_m
+        eta = water.elevation_m[n:].tolist()     # base_link, fore, aft, sounder
         volume = float(areas.sum()) * self.hull.strip_length_m
         beach = self.world.beach
         ground = beach.height_m(self.x)
@@ -464,10 +464,10 @@ class SimCore:
 
         sounder_z = sensor_z(sens.depth_sounder_x_m, sens.depth_sounder_z_m)
         sounder_ground = beach.height_m(float(px[n + 3]))
-        if eta[n + 3] > sounder_z:
+        if eta[3] > sounder_z:
             sounder = sounder_z - sounder_ground
         else:
-            sounder = float(eta[n + 3]) - sounder_z
+            sounder = eta[3] - sounder_z
         if stepped is None:
             tracks = None
             thrust = [0.0, 0.0]
@@ -521,10 +521,10 @@ class SimCore:
                                        / self._weight if self.in_contact else 0.0),
             waterline_distance_m=beach.distance_along_slope_m(self.x),
             slope_rad=slope, ground_height_m=ground,
-            wave_elevation_m=float(eta[n]), water_depth_m=float(eta[n]) - ground,
-            fore_sensor_depth_m=float(eta[n + 1]) - sensor_z(sens.fore_water_x_m,
+            wave_elevation_m=eta[0], water_depth_m=eta[0] - ground,
+            fore_sensor_depth_m=eta[1] - sensor_z(sens.fore_water_x_m,
                                                               sens.fore_water_z_m),
-            aft_sensor_depth_m=float(eta[n + 2]) - sensor_z(sens.aft_water_x_m,
+            aft_sensor_depth_m=eta[2] - sensor_z(sens.aft_water_x_m,
                                                              sens.aft_water_z_m),
             sounder_depth_m=sounder, medium=medium,
             wave_surge_force_n=c * fwx + s * fwy, in_ground_contact=self.in_contact)

@@ -3,7 +3,11 @@
 Each SWATH hull is a right circular cylinder (vehicle.md section 6) cut into equal
 strips; a strip's immersed section is the circular segment under the instantaneous
 water surface (``dukw_estimation.buoyancy.segment_area_m2``), so the hull's volume is
-``buoyancy.hull_volume_from_depths``. The same strips give the heave force and the
+``buoyancy.hull_volume_from_depths`` up to the float line. The cylinders alone are
+almost wholly immersed when afloat (0.288 of 0.313 m^3): 4 cm above the float line
+their waterplane vanishes and a 28 cm wave would leave heave and pitch without
+stiffness. Above the float line each hull therefore continues wall-sided (the SWATH
+struts), with the waterplane area of vehicle.md section 1 (A_W = 0.89 m^2). The same strips give the heave force and the
 roll and pitch moments, and the Froude-Krylov surge force from the water's particle
 acceleration. The rigid-body inertias are chosen from the linearised hydrostatic
 stiffness at the calm-water equilibrium so that heave, roll and pitch oscillate at the
@@ -33,6 +37,11 @@ class HullGeometry:
     bottom_above_cg_m: float     # hull bottom height relative to the centre of gravity (< 0)
     axis_above_cg_m: float
     stations_per_hull: int
+    float_depth_m: float         # water over the hull bottom when afloat in calm water
+    strut_width_m: float         # wall-sided width of each hull above the float line
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, '_dry', np.zeros(self.station_x_m.size))
 
     @classmethod
     def from_vehicle(cls, vehicle: Vehicle, stations_per_hull: int) -> 'HullGeometry':
@@ -43,27 +52,40 @@ class HullGeometry:
         xs = -body.hull_length_m / 2.0 + dx * (np.arange(n) + 0.5)
         p = body.hull_separation_m / 2.0
         bottom = body.hull_clearance_m - body.kg_m
+        float_depth = cylinder_float_depth_m(body.displaced_volume_m3, body.hull_radius_m,
+                                             body.hull_length_m)
+        strut = body.waterplane_area_m2 / (2.0 * body.hull_length_m)
         return cls(np.concatenate([xs, xs]), np.concatenate([np.full(n, p), np.full(n, -p)]),
-                   dx, body.hull_radius_m, bottom, bottom + body.hull_radius_m, n)
+                   dx, body.hull_radius_m, bottom, bottom + body.hull_radius_m, n,
+                   float_depth, strut)
 
     def areas_m2(self, depth_over_bottom_m: np.ndarray) -> np.ndarray:
-        """Immersed section of each strip from the water height over its bottom, m^2."""
-        return segment_area_m2(depth_over_bottom_m, self.radius_m)
+        """Immersed section of each strip from the water height over its bottom, m^2.
 
-    def calm_equilibrium_depth_m(self, displaced_volume_m3: float) -> float:
-        """Water depth over the hull bottoms when floating level in calm water, m."""
-        target = displaced_volume_m3 / (2.0 * self.stations_per_hull * self.strip_length_m)
-        full = math.pi * self.radius_m ** 2
-        if target >= full:
-            raise ValueError('the hulls cannot carry the displacement (hull_radius_m too small)')
-        lo, hi = 0.0, 2.0 * self.radius_m
-        for _ in range(60):
-            mid = 0.5 * (lo + hi)
-            if float(segment_area_m2(mid, self.radius_m)) < target:
-                lo = mid
-            else:
-                hi = mid
-        return 0.5 * (lo + hi)
+        The cylinder's circular segment up to the float line, wall-sided above it.
+        """
+        d = depth_over_bottom_m
+        if d.max() <= 0.0:
+            return self._dry
+        above = d - self.float_depth_m
+        return (segment_area_m2(np.minimum(d, self.float_depth_m), self.radius_m)
+                + self.strut_width_m * np.maximum(above, 0.0))
+
+
+def cylinder_float_depth_m(displaced_volume_m3: float, radius_m: float,
+                           length_m: float) -> float:
+    """Water over the bottoms of two level cylinders that displace the volume given, m."""
+    target = displaced_volume_m3 / (2.0 * length_m)
+    if target >= math.pi * radius_m ** 2:
+        raise ValueError('the hulls cannot carry the displacement (hull_radius_m too small)')
+    lo, hi = 0.0, 2.0 * radius_m
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if float(segment_area_m2(mid, radius_m)) < target:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
 
 
 @dataclass(frozen=True)
@@ -87,11 +109,8 @@ class Seakeeping:
         """Inertias from the strip stiffness at the calm equilibrium and the measured frequencies."""
         body = vehicle.body
         rho_g = body.water_density_kgpm3 * body.gravity_mps2
-        d0 = hull.calm_equilibrium_depth_m(body.displaced_volume_m3)
-        eps = 1e-4
-        width = (float(segment_area_m2(d0 + eps, hull.radius_m))
-                 - float(segment_area_m2(d0 - eps, hull.radius_m))) / (2.0 * eps)
-        strip = rho_g * width * hull.strip_length_m
+        d0 = hull.float_depth_m
+        strip = rho_g * hull.strut_width_m * hull.strip_length_m   # waterplane at the float line
         k_heave = strip * hull.station_x_m.size
         k_roll = strip * float(np.sum(hull.station_y_m ** 2))
         k_pitch = strip * float(np.sum(hull.station_x_m ** 2))

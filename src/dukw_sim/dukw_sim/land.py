@@ -55,7 +55,9 @@ def track_step(ref_mps: tuple, ground_mps: tuple, other_n: tuple, max_motor_n: f
         probe_t = np.array([ref_mps[0], ref_mps[0], ref_mps[1], ref_mps[1]])
         probe_g = np.array([ground_mps[0], ground_mps[0] + _SLIP_EPS_MPS,
                             ground_mps[1], ground_mps[1] + _SLIP_EPS_MPS])
-        probe = soil_forces(probe_t, probe_g, weight_per_track_n, soil, area_m2, length_m)
+        probe_slip = traction.slip(probe_t, probe_g)
+        probe = traction.tractive_force_n(probe_slip, weight_per_track_n, soil, area_m2,
+                                          length_m)
     for i in range(2):
         ref = ref_mps[i]
         ground = ground_mps[i]
@@ -84,5 +86,8 @@ def track_step(ref_mps: tuple, ground_mps: tuple, other_n: tuple, max_motor_n: f
         motor.append(soil_n + other_n[i])
         derivs.append(deriv)
         sat.append(saturated)
-    slips = traction.slip(np.array(speeds), np.array(ground_mps)).tolist()
+    if loaded and not any(sat):
+        slips = [float(probe_slip[0]), float(probe_slip[2])]
+    else:
+        slips = traction.slip(np.array(speeds), np.array(ground_mps)).tolist()
     return TrackResult(speeds, forces, motor, slips, derivs, sat)

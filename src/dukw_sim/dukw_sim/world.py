@@ -70,7 +70,7 @@ class Beach:
 
     def heights_m(self, x_m: np.ndarray) -> np.ndarray:
         """Vectorised ``height_m``."""
-        return -np.clip(x_m, self.flat_start_x_m, self._floor_x) * self._tan
+        return np.minimum(np.maximum(x_m, self.flat_start_x_m), self._floor_x) * -self._tan
 
     def distance_along_slope_m(self, x_m: float) -> float:
         """Signed distance from the mean waterline measured along the ground, m."""
@@ -203,11 +203,12 @@ class World:
         self.breaking_ratio = breaking_ratio
         self.reference_depth_m = reference_depth_m
         self._height_scale = waves.height_scale_m if waves.count else 0.0
+        self._cap_per_m = breaking_ratio / self._height_scale if self._height_scale else 0.0
         self._k = np.hypot(waves.kx, waves.ky)
         self._a_omega = waves.amplitude_m * waves.omega_rps
         safe_k = np.where(self._k > 0.0, self._k, 1.0)
-        self._dir_x = waves.kx / safe_k          # unit travel direction of each component
-        self._dir_y = waves.ky / safe_k
+        # unit travel direction of each component, as an (M, 2) matrix for one matmul
+        self._dirs = np.column_stack([waves.kx / safe_k, waves.ky / safe_k])
 
     @property
     def calm(self) -> bool:
@@ -218,8 +219,7 @@ class World:
         """Wave-height factor in [0, 1]: H <= breaking_ratio * local still-water depth."""
         if self.calm:
             return np.zeros_like(still_depth_m)
-        cap = self.breaking_ratio * np.maximum(still_depth_m, 0.0) / self._height_scale
-        return np.minimum(cap, 1.0)
+        return np.minimum(np.maximum(still_depth_m, 0.0) * self._cap_per_m, 1.0)
 
     def sample(self, x_m: np.ndarray, y_m: np.ndarray, t_s: float, kin_points: int = 0,
                kin_height_m: float = 0.0) -> WaterSample:
@@ -244,17 +244,14 @@ class World:
         if kin_points <= 0:
             kin = np.zeros(0)
             return WaterSample(eta, kin, kin, kin, kin)
-        depth = max(float(still[:kin_points].mean()), _MIN_KINEMATIC_DEPTH_M)
+        depth = max(float(still[:kin_points].sum()) / kin_points, _MIN_KINEMATIC_DEPTH_M)
         zc = min(max(kin_height_m, -depth), 0.0)
         transfer = np.cosh(self._k * (zc + depth)) / np.sinh(self._k * depth)
         speed = transfer * self._a_omega
-        sin_p = np.sin(phase[:kin_points])
-        f = factor[:kin_points]
-        cos_k = cos_p[:kin_points]
-        accel = speed * w.omega_rps
-        return WaterSample(eta, f * (cos_k @ (speed * self._dir_x)),
-                           f * (cos_k @ (speed * self._dir_y)),
-                           f * (sin_p @ (accel * self._dir_x)), f * (sin_p @ (accel * self._dir_y)))
+        f = factor[:kin_points, None]
+        vel = f * (cos_p[:kin_points] @ (speed[:, None] * self._dirs))
+        acc = f * (np.sin(phase[:kin_points]) @ ((speed * w.omega_rps)[:, None] * self._dirs))
+        return WaterSample(eta, vel[:, 0], vel[:, 1], acc[:, 0], acc[:, 1])
 
     def elevation_m(self, x_m: float, y_m: float, t_s: float) -> float:
         """Water surface above mean level at one point, m."""

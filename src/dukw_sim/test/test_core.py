@@ -96,15 +96,32 @@ def test_reset_starts_on_sand_in_the_surf_and_afloat():
 
 
 def test_submerged_volume_is_the_shared_strip_model():
+    """Up to the float line the hulls are the shared cylinders, wall-sided above it."""
     sim = SimCore.from_config(overrides=WAVES, seed=1)
     sim.reset('surf')
     truth = run(sim, Actuation(30, 30), 150)
     _, _, depths, _ = sim._hydro()
     n = sim.hull.stations_per_hull
     r, length = sim.vehicle.body.hull_radius_m, sim.vehicle.body.hull_length_m
-    expected = (hull_volume_from_depths(depths[:n], r, length)
-                + hull_volume_from_depths(depths[n:], r, length))
-    assert truth.submerged_volume_m3 == pytest.approx(expected)
+    d_float = sim.hull.float_depth_m
+    cylinders = sum(hull_volume_from_depths(np.minimum(d, d_float), r, length)
+                    for d in (depths[:n], depths[n:]))
+    struts = (sim.vehicle.body.waterplane_area_m2 / 2.0 * length / n
+              * float(np.sum(np.maximum(depths - d_float, 0.0))))
+    assert truth.submerged_volume_m3 == pytest.approx(cylinders + struts)
+    assert truth.submerged_volume_m3 > 0.0
+
+
+def test_floats_at_the_displacement_with_the_papers_waterplane():
+    sim = SimCore.from_config()
+    afloat = sim.reset('afloat')
+    body = sim.vehicle.body
+    assert afloat.submerged_volume_m3 == pytest.approx(body.displaced_volume_m3, rel=1e-4)
+    # draft: base_link (the track bottoms) this far under the surface, vehicle.md 1: 0.49 m
+    assert -afloat.z_m == pytest.approx(body.draft_m, abs=0.02)
+    heave = sim.seakeeping.heave_stiffness_n_per_m
+    rho_g = body.water_density_kgpm3 * body.gravity_mps2
+    assert heave == pytest.approx(rho_g * body.waterplane_area_m2)
 
 
 def test_imu_at_rest_reads_gravity_and_the_slope():
