@@ -1,17 +1,22 @@
-"""The control cores closed around the simulator core, with truth as the feedback.
+"""The control cores closed around the simulator core.
 
 The controller sees what its node would see: surge speed and yaw rate (odometry),
-pitch (IMU), track currents and slips; the mode manager sees water contact (wet
-when the sensor point is under the surface), a valid depth deeper than the
-sounder's minimum, the weight on the tracks and the track force (current x gain),
-at the drivers' 20 Hz. All from dukw_sim's Truth, not yet through the sensor
-models and the EKF.
+pitch (IMU), track currents and slips; the mode manager sees water contact, a
+valid depth, the weight on the tracks and the track force (current x gain).
+
+``feedback='truth'``: all of it straight from dukw_sim's Truth (water contact wet
+when the sensor point is under the surface, depth valid deeper than the sounder's
+minimum), status at the drivers' 20 Hz.
+``feedback='ekf'``: the simulator's seeded sensor models (dukw_sim.sensors) feed the
+estimator core (dukw_estimation) as ekf_node does; odometry and traction come from
+the filter, water contact, depth, pitch and motor status from the sensor readings.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 from dukw_common.config import node_params
+from dukw_common.geometry import euler_from_quaternion
 from dukw_control import controller, modes
 from dukw_control.controller import ControllerSettings, DriveController
 from dukw_control.modes import ModeManager, ModeSettings
@@ -45,9 +50,20 @@ class ClosedLoop:
     def __init__(self, sim_overrides=None, seed: int = 0, start: str = 'sand',
                  x_m: float | None = None, yaw_rad: float = 0.0,
                  controller_settings: ControllerSettings | None = None,
-                 mode_settings: ModeSettings | None = None) -> None:
+                 mode_settings: ModeSettings | None = None, feedback: str = 'truth') -> None:
+        if feedback not in ('truth', 'ekf'):
+            raise ValueError(f"feedback must be 'truth' or 'ekf', got {feedback!r}")
         self.sim = SimCore.from_config(overrides=sim_overrides or {}, seed=seed)
         self.truth = self.sim.reset(start, x_m, yaw_rad)
+        self.feedback = feedback
+        if feedback == 'ekf':
+            from dukw_estimation.evaluate import SensorAdapter, build_estimator
+            from dukw_sim.sensors import SensorModel
+            self.sensors = SensorModel.from_config(seed=seed)
+            gps = self.sensors.config.gps
+            self.est = build_estimator(self.sim.vehicle, (gps.datum_lat_deg, gps.datum_lon_deg,
+                                                          gps.datum_alt_m))
+            self.adapter = SensorAdapter(self.est)
         self.ctrl = DriveController(controller_settings or default_controller_settings())
         self.modes = ModeManager(mode_settings or default_mode_settings())
         self.gain = self.sim.vehicle.drivetrain.track_force_gain_n_per_a
@@ -64,22 +80,17 @@ class ClosedLoop:
 
     def step(self, cmd: tuple[float, float] | None) -> Truth:
         """One 0.01 s cycle; ``cmd`` is a cmd_vel (v, w) arriving now, or None."""
-        tr, c, t = self.truth, self.ctrl, self.truth.t_s
+        c, t = self.ctrl, self.truth.t_s
         if cmd is not None:
             c.on_cmd_vel(*cmd, t)
-        c.on_odometry(tr.surge_mps, tr.yaw_rate_rps, t)
-        c.on_pitch(tr.pitch_rad, t)
-        c.on_slips(tr.port_slip, tr.stbd_slip, t)
+        if self.feedback == 'truth':
+            self._feed_truth(t)
+        else:
+            self._feed_sensors(t)
         if self.k % STATUS_EVERY == 0:
-            c.on_track_currents(tr.port_current_a, tr.stbd_current_a, t)
-            m = self.modes
-            m.on_water_contact(tr.fore_sensor_depth_m > 0.0, tr.aft_sensor_depth_m > 0.0, t)
-            m.on_depth(tr.sounder_depth_m > self.min_depth_m, tr.sounder_depth_m, t)
-            m.on_traction(tr.weight_on_tracks_fraction, t)
-            m.on_track_forces(tr.port_current_a * self.gain, tr.stbd_current_a * self.gain, t)
-            decision = m.update(t)
-            if m.changed:
-                m.changed = False
+            decision = self.modes.update(t)
+            if self.modes.changed:
+                self.modes.changed = False
                 c.on_mode(decision)
                 self.record.modes.append((t, decision.mode, decision.reason))
         out = c.step(t)
@@ -91,6 +102,40 @@ class ClosedLoop:
         rec.tracks.append((out.tracks.port, out.tracks.stbd))
         rec.props.append((out.props.port, out.props.stbd))
         return self.truth
+
+    def _feed_truth(self, t: float) -> None:
+        tr, c, m = self.truth, self.ctrl, self.modes
+        c.on_odometry(tr.surge_mps, tr.yaw_rate_rps, t)
+        c.on_pitch(tr.pitch_rad, t)
+        c.on_slips(tr.port_slip, tr.stbd_slip, t)
+        if self.k % STATUS_EVERY == 0:
+            c.on_track_currents(tr.port_current_a, tr.stbd_current_a, t)
+            m.on_water_contact(tr.fore_sensor_depth_m > 0.0, tr.aft_sensor_depth_m > 0.0, t)
+            m.on_depth(tr.sounder_depth_m > self.min_depth_m, tr.sounder_depth_m, t)
+            m.on_traction(tr.weight_on_tracks_fraction, t)
+            m.on_track_forces(tr.port_current_a * self.gain, tr.stbd_current_a * self.gain, t)
+
+    def _feed_sensors(self, t: float) -> None:
+        c, m = self.ctrl, self.modes
+        for reading in self.sensors.sample(self.truth):
+            self.adapter.feed(reading)
+            kind = type(reading).__name__
+            if kind == 'ImuReading':
+                c.on_pitch(euler_from_quaternion(*reading.orientation_xyzw)[1], t)
+            elif kind == 'WaterContactReading':
+                m.on_water_contact(reading.fore_wet, reading.aft_wet, t)
+            elif kind == 'DepthReading':
+                m.on_depth(reading.valid, reading.depth_m, t)
+            elif kind == 'DrivetrainReading' and reading.drive == 'tracks' and reading.connected:
+                c.on_track_currents(reading.port.current_a, reading.stbd.current_a, t)
+                m.on_track_forces(reading.port.force_n, reading.stbd.force_n, t)
+        if self.est.t_s is None:
+            return
+        self.est.advance(t)
+        odo, trc = self.est.odometry(), self.est.traction()
+        c.on_odometry(odo.surge_mps, odo.yaw_rate_rps, t)
+        c.on_slips(trc.port_slip, trc.stbd_slip, t)
+        m.on_traction(trc.weight_on_tracks_fraction, t)
 
     def run(self, seconds: float, cmd: tuple[float, float] | None = (1.0, 0.0),
             until=None) -> Truth:
