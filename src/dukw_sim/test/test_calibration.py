@@ -184,3 +184,17 @@ def test_deterministic_with_a_seed():
     b = maneuver.transition('land-to-sea', 72, wave_height_m=0.28, seed=5, duration_s=8.0)
     assert [t.x_m for t in a.rows] == [t.x_m for t in b.rows]
     assert a.summary == b.summary
+
+
+def test_the_papers_beach_fit_cannot_climb_eleven_degrees():
+    """Why the land calibration uses dry sand: on the wet-beach fit (c 0.15 kPa, phi 9.9 deg)
+    the soil gives at most ~2 x 262 N, less than the 552 N of gravity on 11 deg."""
+    sim = SimCore.from_config(overrides={'site.beach_slope_rad': math.radians(11.0),
+                                         'world.flat_start_x_m': -60.0,
+                                         'world.dry_soil_preset': 'beach_72'})
+    sim.reset(x_m=-10.0, yaw_rad=math.pi)
+    start = sim.truth.ground_height_m
+    for _ in range(800):
+        truth = sim.step(Actuation(100, 96))
+    assert truth.ground_height_m < start                     # slid back down
+    assert truth.port_slip > 0.5 or truth.port_slip < 0.0     # tracks spinning, not climbing
