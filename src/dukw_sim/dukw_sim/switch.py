@@ -51,7 +51,7 @@ class RcReading:
     t_s: float
     link_ok: bool
     rc_selected: bool
-    channels_us: tuple[float, ...]   # port stick, starboard stick; 0 = no pulse
+    channels_us: tuple[float, ...]   # tracks port, stbd, props port, stbd; 0 = no pulse
 
 
 @dataclass(frozen=True)
@@ -112,10 +112,11 @@ class SimServoSwitch:
         return SwitchOutputs(NEUTRAL, NEUTRAL, 'neutral')
 
     def rc_reading(self, t_s: float) -> RcReading:
-        """The stick channels' pulses around neutral (none without link) and the select line."""
+        """The four stick channels (the servo switch's stick_channels, in its output order:
+        tracks port, stbd, props port, stbd) around neutral, none without link."""
         op, ch = self.operator, self.channels
         if not op.rc_link_ok:
-            return RcReading(t_s, False, op.rc_selected, (0.0, 0.0))
-        return RcReading(t_s, True, op.rc_selected,
-                         (ch.neutral_us + ch.us_per_pct * op.sticks.port_pct,
-                          ch.neutral_us + ch.us_per_pct * op.sticks.stbd_pct))
+            return RcReading(t_s, False, op.rc_selected, (0.0,) * 4)
+        port = ch.neutral_us + ch.us_per_pct * op.sticks.port_pct
+        stbd = ch.neutral_us + ch.us_per_pct * op.sticks.stbd_pct
+        return RcReading(t_s, True, op.rc_selected, (port, stbd, port, stbd))

@@ -150,7 +150,7 @@ def test_operator_takeover_blocks_the_computer_and_link_loss_is_neutral(sim_fact
         assert probe.until(lambda: probe.get('authority').holder == Authority.HOLDER_RC)
         assert probe.until(lambda: probe.tracks_cmd() == (-30.0, -30.0))
         rc = probe.fresh('rc/input')
-        assert rc.rc_selected and rc.link_ok and list(rc.channels_us) == [1350.0, 1350.0]
+        assert rc.rc_selected and rc.link_ok and list(rc.channels_us) == [1350.0] * 4
         for _ in range(3):
             assert probe.fresh('tracks/status').port.command_pct == -30.0
         # hand back: the computer's fresh commands pass again

@@ -58,7 +58,7 @@ def test_link_loss_is_neutral_whoever_held_authority(selected):
     assert sw.state.reason == Reason.RC_LINK_LOST and sw.state.outputs_neutral
     assert not sw.command('tracks', 60.0, 56.0, now_s=0.2)
     reading = sw.rc_reading(0.2)
-    assert (reading.link_ok, reading.channels_us) == (False, (0.0, 0.0))
+    assert (reading.link_ok, reading.channels_us) == (False, (0.0,) * 4)
 
 
 @pytest.mark.parametrize('port,stbd', [(math.nan, 0.0), (0.0, math.inf), (100.5, 0.0)])
@@ -84,7 +84,7 @@ def test_rc_reading_encodes_the_sticks_as_pulse_widths():
     reading = sw.rc_reading(3.0)
     neutral, per_pct = PARAMS['rc.neutral_us'], PARAMS['rc.us_per_pct']
     assert reading.rc_selected and reading.link_ok and reading.t_s == 3.0
-    assert reading.channels_us == (neutral + 100 * per_pct, neutral - 50 * per_pct)
+    assert reading.channels_us == (neutral + 100 * per_pct, neutral - 50 * per_pct) * 2
 
 
 def test_changed_flag_marks_each_authority_change():
