@@ -143,3 +143,12 @@ def test_rc_authority_and_clock_messages():
     assert (auth.holder, auth.reason) == (Authority.HOLDER_RC, Authority.REASON_RC_SWITCH)
     clock = msgs.clock(12.345)
     assert (clock.clock.sec, clock.clock.nanosec) == (12, 345_000_000)
+
+
+def test_one_off_builders_return_fresh_messages():
+    from dukw_sim import sim_messages as sm
+    a = sm.depth(DepthReading(1.0, True, 1.5, 0.0, 18.0), FRAMES)
+    b = sm.depth(DepthReading(2.0, True, 2.5, 0.0, 18.0), FRAMES)
+    assert (a.depth_m, b.depth_m) == (1.5, 2.5) and a.header.frame_id == 'base_link'
+    state = AuthorityState(Holder.COMPUTER, Reason.RC_SWITCH, True, False, 'computer')
+    assert sm.authority(state, 1.0).holder == Authority.HOLDER_COMPUTER
