@@ -36,6 +36,7 @@ GPS_FIX_STATUS = {2: FixStatus.FIX, 3: FixStatus.FIX, 4: FixStatus.SBAS_FIX,
                   8: FixStatus.FIX}
 IMU_PRIORITY = {'RAW_IMU': 1, 'SCALED_IMU': 2, 'HIGHRES_IMU': 3}
 UINT16_UNKNOWN = 65535
+START_MARKERS = (mavlink.PROTOCOL_MARKER_V1, mavlink.PROTOCOL_MARKER_V2)
 
 _HALF_SQRT2 = math.sqrt(0.5)
 #: Rotation NED -> ENU (180 deg about (1, 1, 0)/sqrt 2) and FLU -> FRD (180 deg about x), xyzw.
@@ -109,7 +110,8 @@ class MavlinkCounters:
     """What the decoder has seen since start."""
 
     packets: int = 0        # well-formed packets (CRC good) of any type
-    frame_errors: int = 0   # bad CRC or length, junk between packets, unknown message id
+    frame_errors: int = 0   # bad CRC or length, junk between packets
+    unknown_ids: int = 0    # well-framed packets of ids the common dialect lacks (unchecked)
     parse_errors: int = 0   # well-formed packets with unusable values (NaN, out of range)
     ignored: int = 0        # packets of types not used (or superseded)
     by_type: dict[str, int] = field(default_factory=dict)
@@ -135,6 +137,7 @@ class MavlinkImuDecoder:
         self.settings = settings
         self.counters = MavlinkCounters()
         self._parser = self._new_parser()
+        self._suspect: tuple[object, bytes] | None = None   # an unknown-id frame, undecided
         self._use_quaternion = False
         self._imu_priority = 0
         self._accel: tuple[float, float, float] | None = None
@@ -144,16 +147,19 @@ class MavlinkImuDecoder:
     def feed(self, data: bytes, now_s: float) -> list[Decoded]:
         """Decode received bytes at time ``now_s``."""
         try:
-            messages = self._parser.parse_buffer(data) or []
+            messages = self._frames(data)
         except (mavlink.MAVError, struct.error, ValueError, TypeError, IndexError):
             self.counters.frame_errors += 1
-            self._parser = self._new_parser()
+            self._parser, self._suspect = self._new_parser(), None
             return []
         out: list[Decoded] = []
-        for msg in messages:
+        for msg, trusted in messages:
             kind = msg.get_type()
-            if kind == 'BAD_DATA' or kind.startswith('UNKNOWN_'):  # unknown ids: no CRC check
+            if not trusted:
                 self.counters.frame_errors += 1
+                continue
+            if kind.startswith('UNKNOWN_'):  # another dialect's message, or a corrupted id
+                self.counters.unknown_ids += 1
                 continue
             self.counters.packets += 1
             self.counters.by_type[kind] = self.counters.by_type.get(kind, 0) + 1
@@ -169,6 +175,45 @@ class MavlinkImuDecoder:
             if result is not None:
                 out.append(result)
         return out
+
+    def _frames(self, data: bytes) -> list[tuple[object, bool]]:
+        """Parse frame by frame into (message, trusted); rescan after a frame that is broken.
+
+        pymavlink's parser trusts a frame's length byte and drops the whole frame on a
+        bad CRC, so one corrupted length byte would swallow up to 280 good bytes. A
+        frame with a bad CRC, or with an unknown id (no CRC check possible) that is not
+        followed by a start marker, is rescanned from its second byte instead. An
+        unknown-id frame at the end of the input waits for the next byte to decide.
+        """
+        frames: list[tuple[object, bool]] = []
+        if self._suspect is not None and data:
+            msg, frame = self._suspect
+            self._suspect = None
+            trusted = data[0] in START_MARKERS
+            frames.append((msg, trusted))
+            if not trusted:
+                self._parser = self._new_parser()
+                data = frame[1:] + data
+        parser = self._parser
+        pending = bytes(parser.buf[parser.buf_index:]) + data
+        msg = parser.parse_char(data)
+        while msg is not None:
+            kind, left = msg.get_type(), parser.buf_len()
+            frame, pending = pending[:len(pending) - left], pending[len(pending) - left:]
+            broken = kind == 'BAD_DATA' and msg.reason != 'Bad prefix'
+            if kind.startswith('UNKNOWN_'):
+                if not pending:
+                    self._suspect = (msg, frame)
+                    break
+                broken = pending[0] not in START_MARKERS
+            frames.append((msg, not broken and kind != 'BAD_DATA'))
+            if broken:
+                pending = frame[1:] + pending
+                self._parser = parser = self._new_parser()
+                msg = parser.parse_char(pending)
+            else:
+                msg = parser.parse_char(b'')
+        return frames
 
     @staticmethod
     def _new_parser() -> mavlink.MAVLink:
