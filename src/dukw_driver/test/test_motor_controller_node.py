@@ -3,14 +3,14 @@ import math
 import time
 
 import pytest
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from diagnostic_msgs.msg import DiagnosticStatus
 from dukw_msgs.msg import DrivetrainStatus, MotorSide
 
-from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, parameter_overrides
-from dukw_common.testing import NodeProcess, ros_node, spin_until
+from dukw_common.testing import NodeProcess, ros_node
 from dukw_driver.motor_controller_node import MotorControllerNode
 from fake_device import FakeDevice
 from fake_roboteq import FakeRoboteq
+from node_graph import NodeGraph
 
 pytestmark = pytest.mark.ros
 
@@ -23,25 +23,19 @@ def roboteq(tmp_path):
         yield emulator
 
 
-class Graph:
-    def __init__(self, probe, executor, port, drive):
-        self.executor = executor
-        self.node = MotorControllerNode(context=probe.context,
-                                        parameter_overrides=parameter_overrides(
-                                            {'port': port, 'drive': drive}))
-        executor.add_node(self.node)
-        self.status: list[DrivetrainStatus] = []
-        self.diagnostics: list[DiagnosticStatus] = []
-        probe.create_subscription(DrivetrainStatus, f'{drive}/status', self.status.append,
-                                  SENSOR_QOS)
-        probe.create_subscription(DiagnosticArray, '/diagnostics',
-                                  lambda m: self.diagnostics.extend(m.status), COMMAND_QOS)
+class Graph(NodeGraph):
+    """motor_controller_node (``drive``) plus a probe recording its status."""
 
-    def spin_until(self, predicate, timeout_s=5.0):
-        return spin_until(self.executor, predicate, timeout_s)
+    def __init__(self, probe, executor, port, drive):
+        super().__init__(probe, executor, MotorControllerNode, port=port, drive=drive)
+        self.msgs = self.record(DrivetrainStatus, f'{drive}/status')
 
     def connected(self):
-        return bool(self.status) and self.status[-1].connected
+        return bool(self.msgs) and self.msgs[-1].connected
+
+    def level(self):
+        status = self.status('controller')
+        return None if status is None else status.level
 
 
 @pytest.fixture
@@ -49,12 +43,12 @@ def tracks(roboteq):
     with ros_node('probe_motor_tracks') as (probe, executor):
         graph = Graph(probe, executor, str(roboteq.device.path), 'tracks')
         yield graph
-        graph.node.destroy_node()
+        graph.close()
 
 
 def test_tracks_status_from_the_controller(tracks, roboteq):
     assert tracks.spin_until(tracks.connected)
-    status = tracks.status[-1]
+    status = tracks.msgs[-1]
     assert status.drive == DrivetrainStatus.DRIVE_TRACKS
     assert status.port.current_a == pytest.approx(12.3)
     assert status.port.force_n == pytest.approx(12.3 * 8.16)
@@ -63,41 +57,40 @@ def test_tracks_status_from_the_controller(tracks, roboteq):
     assert status.port.voltage_v == pytest.approx(24.6) and status.port.temperature_c == 41
     assert status.port.fault_flags == 0 and list(status.port.faults) == []
     roboteq.fault_flags, roboteq.motor_flags = 0b10, (0b10, 0)
-    assert tracks.spin_until(lambda: tracks.status[-1].port.fault_flags != 0)
-    port = tracks.status[-1].port
+    assert tracks.spin_until(lambda: tracks.msgs[-1].port.fault_flags != 0)
+    port = tracks.msgs[-1].port
     assert port.fault_flags == MotorSide.FAULT_OVERVOLTAGE | MotorSide.FAULT_STALL
     assert list(port.faults) == ['overvoltage', 'stall']
-    assert tracks.spin_until(lambda: any(d.level == DiagnosticStatus.ERROR
-                                         and 'overvoltage' in d.message
-                                         for d in tracks.diagnostics))
+    assert tracks.spin_until(lambda: tracks.level() == DiagnosticStatus.ERROR
+                             and 'overvoltage' in tracks.status('controller').message)
     assert roboteq.commands == []
 
 
 def test_unplug_reports_the_loss_and_replug_publishes_again_within_2_s(tracks, roboteq):
     assert tracks.spin_until(tracks.connected)
     roboteq.device.unplug()
-    assert tracks.spin_until(lambda: not tracks.status[-1].connected)
-    lost = tracks.status[-1]
+    assert tracks.spin_until(lambda: not tracks.msgs[-1].connected)
+    lost = tracks.msgs[-1]
     assert math.isnan(lost.port.current_a)
     assert lost.port.fault_flags & MotorSide.FAULT_COMM_TIMEOUT
-    assert tracks.spin_until(lambda: any(d.level == DiagnosticStatus.ERROR
-                                         and 'not connected' in d.message
-                                         for d in tracks.diagnostics), timeout_s=3.0)
-    count = len(tracks.status)
+    assert tracks.spin_until(lambda: tracks.level() == DiagnosticStatus.ERROR
+                             and 'not connected' in tracks.status('controller').message,
+                             timeout_s=3.0)
+    count = len(tracks.msgs)
     tracks.spin_until(lambda: False, timeout_s=1.0)
-    assert len(tracks.status) > count  # keeps publishing while the device is away
+    assert len(tracks.msgs) > count  # keeps publishing while the device is away
     roboteq.device.replug()
     replugged = time.monotonic()
     assert tracks.spin_until(tracks.connected, timeout_s=2.0)
     assert time.monotonic() - replugged < 2.0
     assert tracks.node.link.reconnects == 1
-    assert tracks.status[-1].port.current_a == pytest.approx(12.3)
+    assert tracks.msgs[-1].port.current_a == pytest.approx(12.3)
 
 
 def test_silent_controller_is_not_connected(tracks, roboteq):
     assert tracks.spin_until(tracks.connected)
     roboteq.device.silent = True
-    assert tracks.spin_until(lambda: not tracks.status[-1].connected)
+    assert tracks.spin_until(lambda: not tracks.msgs[-1].connected)
     roboteq.device.silent = False
     assert tracks.spin_until(tracks.connected)
 
@@ -115,12 +108,12 @@ def test_props_instance_publishes_props_status(roboteq):
         graph = Graph(probe, executor, str(roboteq.device.path), 'props')
         try:
             assert graph.spin_until(graph.connected)
-            status = graph.status[-1]
+            status = graph.msgs[-1]
             assert status.drive == DrivetrainStatus.DRIVE_PROPELLERS
             assert status.port.speed_mps == 0.0
             assert status.port.force_n == pytest.approx(133.0 * 0.60)
         finally:
-            graph.node.destroy_node()
+            graph.close()
 
 
 def test_bad_drive_parameter_is_refused_with_its_name():

@@ -3,13 +3,15 @@ import math
 import time
 
 import pytest
+from diagnostic_msgs.msg import DiagnosticStatus
 from dukw_msgs.msg import Authority, DiffCommand, RcInput
 
-from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS, parameter_overrides
+from dukw_common.node_tools import COMMAND_QOS, STATE_QOS
 from dukw_common.testing import NodeProcess, ros_node, spin_until
 from dukw_driver.servo_switch_node import ServoSwitchNode
 from fake_device import FakeDevice
 from fake_maestro import FakeMaestro
+from node_graph import NodeGraph
 
 pytestmark = pytest.mark.ros
 NEUTRAL_US = [1500.0] * 4
@@ -24,18 +26,13 @@ def maestro(tmp_path):
         yield emulator
 
 
-class Graph:
-    """The node under test plus a probe node in one isolated context."""
+class Graph(NodeGraph):
+    """servo_switch_node plus a probe recording authority and rc/input, publishing commands."""
 
     def __init__(self, probe, executor, port):
-        self.probe, self.executor = probe, executor
-        self.node = ServoSwitchNode(context=probe.context, parameter_overrides=parameter_overrides(
-            {'port': port, 'rate_hz': 50.0}))
-        executor.add_node(self.node)
-        self.authority: list[Authority] = []
-        self.rc: list[RcInput] = []
-        probe.create_subscription(Authority, 'authority', self.authority.append, STATE_QOS)
-        probe.create_subscription(RcInput, 'rc/input', self.rc.append, SENSOR_QOS)
+        super().__init__(probe, executor, ServoSwitchNode, port=port, rate_hz=50.0)
+        self.authority = self.record(Authority, 'authority', STATE_QOS)
+        self.rc = self.record(RcInput, 'rc/input')
         self.tracks = probe.create_publisher(DiffCommand, 'tracks/cmd', COMMAND_QOS)
 
     def spin_until(self, predicate, timeout_s=5.0, command=None):
@@ -44,12 +41,16 @@ class Graph:
             if command is not None:
                 self.tracks.publish(DiffCommand(port_pct=command[0], stbd_pct=command[1]))
             return predicate()
-        return spin_until(self.executor, check, timeout_s)
+        return super().spin_until(check, timeout_s)
 
     def holder_is(self, holder, reason=None):
         last = self.authority[-1] if self.authority else None
         return last is not None and last.holder == holder and (
             reason is None or last.reason == reason)
+
+    def level(self):
+        status = self.status('maestro')
+        return None if status is None else status.level
 
 
 @pytest.fixture
@@ -57,7 +58,7 @@ def graph(maestro):
     with ros_node('probe_servo_switch') as (probe, executor):
         graph = Graph(probe, executor, str(maestro.device.path))
         yield graph
-        graph.node.destroy_node()
+        graph.close()
 
 
 def outputs_us(maestro):
@@ -75,6 +76,8 @@ def test_forwards_computer_commands_then_operator_takes_over(graph, maestro):
     assert outputs_us(maestro) == NEUTRAL_US
     assert graph.rc and graph.rc[-1].rc_selected and graph.rc[-1].link_ok
     assert len(graph.rc[-1].channels_us) == 4
+    assert graph.spin_until(lambda: graph.level() == DiagnosticStatus.OK, timeout_s=3.0)
+    assert float(graph.value('maestro', 'message_rate_hz')) > 0
 
 
 def test_rc_link_loss_is_neutral(graph, maestro):
@@ -109,7 +112,8 @@ def test_unplug_reports_the_loss_and_replug_publishes_again_within_2_s(graph, ma
     maestro.device.unplug()
     assert graph.spin_until(lambda: graph.holder_is(Authority.HOLDER_NONE,
                                                     Authority.REASON_DEVICE_LOST))
-    graph.spin_until(lambda: False, timeout_s=1.5)  # stays down, keeps running, no exception
+    assert graph.spin_until(lambda: graph.level() == DiagnosticStatus.ERROR, timeout_s=3.0)
+    assert graph.value('maestro', 'connected') == 'False'
     assert not graph.node.link.connected and graph.node.link.errors > 1
     seen = len(graph.rc)
     maestro.device.replug()
@@ -118,6 +122,7 @@ def test_unplug_reports_the_loss_and_replug_publishes_again_within_2_s(graph, ma
     assert time.monotonic() - replugged < 2.0
     assert graph.spin_until(lambda: graph.holder_is(Authority.HOLDER_COMPUTER))
     assert graph.node.link.reconnects == 1
+    assert graph.spin_until(lambda: graph.value('maestro', 'reconnects') == '1', timeout_s=3.0)
     assert graph.spin_until(lambda: maestro.target_us(0) == 1800.0, command=(60.0, 56.0))
 
 
