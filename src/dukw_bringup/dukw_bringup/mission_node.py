@@ -14,6 +14,7 @@ import math
 
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
+from rclpy.duration import Duration
 from rclpy.node import Node
 from std_msgs.msg import String
 
@@ -106,6 +107,8 @@ class MissionNode(Node):
         self.guidance.abort()
         self.publish_command(VelocityCommand())
         self.publish_status()
+        for publisher in (self.cmd_pub, self.status_pub):  # deliver them before exiting
+            publisher.wait_for_all_acked(Duration(seconds=0.5))
 
 
 def main(args=None) -> int:
