@@ -59,6 +59,11 @@ class Actuation:
         return self
 
 
+def _require_finite(what: str, *values: float) -> None:
+    if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in values):
+        raise ValueError(f'{what} must be finite numbers, got {values}')
+
+
 def _soil_with_floor(soil: SoilParams, min_k_m: float) -> SoilParams:
     return SoilParams(soil.cohesion_pa, soil.friction_angle_rad,
                       max(soil.shear_modulus_m, min_k_m))
@@ -141,8 +146,7 @@ class SimCore:
             if start not in starts:
                 raise ValueError(f'start must be one of {sorted(starts)}, got {start!r}')
             x_m = starts[start]
-        if not (math.isfinite(x_m) and math.isfinite(yaw_rad)):
-            raise ValueError('reset position and yaw must be finite')
+        _require_finite('reset position and yaw', x_m, yaw_rad)
         self.t_s = 0.0
         self.x, self.y, self.yaw = float(x_m), 0.0, float(yaw_rad)
         self.u = self.v = self.r = 0.0
@@ -163,9 +167,7 @@ class SimCore:
     def perturb(self, heave_m: float = 0.0, roll_rad: float = 0.0,
                 pitch_rad: float = 0.0) -> Truth:
         """Displace a floating vehicle from where it is (a free-decay test); ValueError on land."""
-        for value in (heave_m, roll_rad, pitch_rad):
-            if not math.isfinite(value):
-                raise ValueError('perturbation must be finite')
+        _require_finite('perturbation', heave_m, roll_rad, pitch_rad)
         if self.in_contact:
             raise ValueError('perturb needs the vehicle afloat (tracks off the ground)')
         self.z_cg += heave_m
@@ -177,9 +179,7 @@ class SimCore:
     def set_external_force(self, fx_n: float = 0.0, fy_n: float = 0.0,
                            yaw_moment_nm: float = 0.0) -> None:
         """A horizontal force on the vehicle in odom (a tow line, a hand holding it), N."""
-        for value in (fx_n, fy_n, yaw_moment_nm):
-            if not math.isfinite(value):
-                raise ValueError('external force must be finite')
+        _require_finite('external force', fx_n, fy_n, yaw_moment_nm)
         self._external = (float(fx_n), float(fy_n), float(yaw_moment_nm))
 
     def _ground_pose(self) -> tuple[float, float, float, float]:
