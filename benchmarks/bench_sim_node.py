@@ -22,28 +22,15 @@ from rclpy.context import Context
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 
-from diagnostic_msgs.msg import DiagnosticArray
-from dukw_msgs.msg import (Authority, Depth, DiffCommand, DrivetrainStatus, RcInput, SimTruth,
-                           WaterContact)
-from geometry_msgs.msg import TwistWithCovarianceStamped
-from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import Imu, NavSatFix
+from dukw_msgs.msg import DiffCommand
 
-from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS, stamp_to_s
+from dukw_common.node_tools import COMMAND_QOS, stamp_to_s
 from dukw_common.testing import NodeProcess
+from dukw_sim.sim_messages import TOPICS
 
 if 'ROS_DOMAIN_ID' not in os.environ:   # keep clear of a running stack and of tests
     os.environ['ROS_DOMAIN_ID'] = str(90 + os.getpid() % 10)
 os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-
-TOPICS = [('imu/data', Imu, SENSOR_QOS), ('gps/fix', NavSatFix, SENSOR_QOS),
-          ('gps/vel', TwistWithCovarianceStamped, SENSOR_QOS),
-          ('water/contact', WaterContact, SENSOR_QOS), ('depth', Depth, SENSOR_QOS),
-          ('tracks/status', DrivetrainStatus, SENSOR_QOS),
-          ('props/status', DrivetrainStatus, SENSOR_QOS), ('rc/input', RcInput, SENSOR_QOS),
-          ('authority', Authority, STATE_QOS), ('sim/truth', SimTruth, SENSOR_QOS),
-          ('/clock', Clock, COMMAND_QOS), ('/diagnostics', DiagnosticArray, COMMAND_QOS)]
-
 
 def cpu_seconds(pid: int) -> float:
     """User + system CPU seconds of a process (Linux /proc)."""

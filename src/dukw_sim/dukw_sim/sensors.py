@@ -26,6 +26,7 @@ from dukw_common.config import ConfigError, ParamValue, node_params, require
 from dukw_common.geometry import geodetic_from_local_enu, quaternion_from_euler
 from dukw_common.vehicle import (DrivetrainParams, SensorMounts, drivetrain_params,
                                   sensor_mounts)
+from dukw_driver.motors import prop_thrust_n
 from dukw_sim.truth import Truth
 
 NODE_NAME = 'sim_node'
@@ -556,15 +557,13 @@ class SensorModel:
             lambda current_a, pct: current_a * gain)
 
     def props(self, truth: Truth) -> DrivetrainReading:
-        """The propellers' controller: no encoder (speed 0); thrust estimated from the command."""
-        dt = self.config.drivetrain
-
-        def thrust_n(current_a: float, pct: float) -> float:
-            ratio = 1.0 if pct >= 0 else dt.prop_reverse_thrust_ratio
-            return dt.max_prop_thrust_n * ratio * pct / 100.0
+        """The propellers' controller: no encoder (speed 0); thrust estimated from the command
+        as motor_controller_node does (dukw_driver.motors.prop_thrust_n)."""
+        drivetrain = self.config.drivetrain
         return self._drivetrain(
             truth, 'props', (truth.port_prop_cmd_pct, truth.stbd_prop_cmd_pct),
-            (truth.port_prop_current_a, truth.stbd_prop_current_a), None, thrust_n)
+            (truth.port_prop_current_a, truth.stbd_prop_current_a), None,
+            lambda current_a, pct: prop_thrust_n(pct, drivetrain))
 
     def _drivetrain(self, truth: Truth, drive: str, commands: tuple, currents: tuple,
                     speeds: tuple | None, force_n) -> DrivetrainReading:
