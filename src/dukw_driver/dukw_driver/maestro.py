@@ -15,9 +15,11 @@ propeller controller); one input channel reads a logic line that is high while
 the multiplexer's select line gives the RC side, another a logic line that is
 high while the RC receiver has a valid link (e.g. an RC switch with digital
 output on a channel whose receiver fail-safe value turns it off); optional
-input channels read RC stick positions through pulse-to-voltage converters
-(0..5 V spanning the calibrated pulse range). The replies carry no framing, so
-the parser validates every value and drops a whole batch on anything odd.
+input channels read the RC receiver's outputs into the multiplexer (port track,
+stbd track, port prop, stbd prop, as on ``rc/input``) through pulse-to-voltage
+converters (0..5 V spanning the calibrated pulse range); 0 us while the link is
+lost. The replies carry no framing, so the parser validates every value and
+drops a whole batch on anything odd.
 """
 from __future__ import annotations
 
@@ -245,6 +247,8 @@ class ServoSwitch:
         self.device_errors = tuple(decode_errors(values[-1]))
         selected = self._select_high == cfg.select_rc_when_high
         link_ok = self._link_high == cfg.link_ok_when_high
+        if not link_ok:  # the receiver's outputs mean nothing now: report "no pulse"
+            sticks = (0.0,) * len(sticks)
         self.last_reading = RcReading(selected, link_ok, sticks, self.device_errors)
         self._last_reading_s = now_s
         self.gate.update_rc(rc_selected=selected, rc_link_ok=link_ok)

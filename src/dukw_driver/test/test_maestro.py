@@ -137,6 +137,9 @@ def test_sticks_are_scaled_to_microseconds():
     run(switch, maestro, 0.0, 0.1)
     us = switch.last_reading.channels_us
     assert us[0] == 1000 and us[1] == 2000 and round(us[2]) == 1500 and round(us[3]) == 1250
+    maestro.set_lines(select_rc=True, link_ok=False)
+    run(switch, maestro, 0.1, 0.2)
+    assert switch.last_reading.channels_us == (0.0,) * 4  # no pulse while the link is lost
 
 
 def test_maestro_errors_are_reported_by_name():
@@ -175,8 +178,10 @@ def test_random_bytes_never_raise(chunks, rnd):
         assert switch.cycle(t).startswith(switch.neutral_frame())
         t += rnd.choice((0.001, 0.02, 0.2))
         reading = switch.feed(chunk, t)
-        if reading is not None:
+        if reading is not None and reading.link_ok:
             assert all(1000 <= us <= 2000 for us in reading.channels_us)
+        elif reading is not None:
+            assert set(reading.channels_us) == {0.0}
 
 
 @settings(max_examples=300, deadline=None)
