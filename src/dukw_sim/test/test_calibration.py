@@ -50,6 +50,18 @@ def test_port_bias_goes_straight_equal_commands_drift_to_port():
     assert heading_drift_deg_over(20.0, 60, 60) > 5.0          # to port: yaw increases
 
 
+def test_port_bias_goes_straight_afloat_too():
+    """Propeller walk turns equal thrust to port; 4 % more on the port propeller cancels it."""
+    def drift_deg(port: float, stbd: float) -> float:
+        sim = SimCore.from_config()
+        sim.reset('afloat')
+        for _ in range(3000):
+            truth = sim.step(Actuation(0, 0, port, stbd))
+        return math.degrees(truth.yaw_rad)
+    assert abs(drift_deg(64, 60)) < 0.5 * drift_deg(60, 60)
+    assert drift_deg(60, 60) > 3.0
+
+
 @pytest.mark.parametrize('port, stbd, radius_m, turn', [(44, 100, 1.93, 'port'),
                                                         (100, 44, 2.24, 'starboard')])
 def test_minimum_land_turning_radius(port, stbd, radius_m, turn):
