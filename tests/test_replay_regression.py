@@ -124,7 +124,7 @@ def test_mode_manager_node_through_real_topics_makes_the_recorded_changes():
             manager.stop()
     assert play_code == 0, player.stdout + player.stderr
     assert [m for _, m in seen] == [m for _, m in recorded], (seen, manager.stderr[-2000:])
-    for (t_seen, mode), (t_rec, _) in list(zip(seen, recorded))[1:]:
+    for (t_seen, mode), (t_rec, _) in list(zip(seen, recorded, strict=True))[1:]:
         # the changes (not the first decision, which depends on when the node's first
         # tick meets its first inputs); the node stamps inputs on arrival
         assert abs(t_seen - t_rec) < 0.3, f'{mode}: at {t_seen:.2f} s, recorded {t_rec:.2f} s'

@@ -231,7 +231,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog='golden', description=__doc__.split('\n')[0])
     parser.add_argument('--out', type=Path, required=True, help='folder of the golden bags')
     parser.add_argument('--only', nargs='+', choices=sorted(SCENARIOS), default=None)
-    parser.add_argument('--config', default=None, help='parameter file (default: the stack\'s)')
+    parser.add_argument('--config', default=None, help='parameter file')
     args = parser.parse_args(sys.argv[1:] if argv is None else argv)
     args.out.mkdir(parents=True, exist_ok=True)
     for name in args.only or SCENARIOS:
