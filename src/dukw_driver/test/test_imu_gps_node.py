@@ -9,8 +9,8 @@ from sensor_msgs.msg import Imu, NavSatFix, NavSatStatus
 
 from dukw_common.config import ConfigError
 from dukw_common.geometry import euler_from_quaternion
-from dukw_common.node_tools import parameter_overrides
-from dukw_common.testing import ros_node
+from dukw_common.node_tools import SENSOR_QOS, parameter_overrides
+from dukw_common.testing import NodeProcess, ros_node, spin_until
 from dukw_driver.imu_gps_node import ImuGpsNode
 from dukw_driver.nmea_stream import nmea_sentence
 from fake_device import FakeDevice
@@ -141,3 +141,19 @@ def test_bad_parameters_are_refused_naming_them(name, value):
         with pytest.raises(ConfigError, match=name.replace('.', r'\.')):
             ImuGpsNode(context=probe.context,
                        parameter_overrides=parameter_overrides({name: value}))
+
+
+def test_installed_executable_publishes_from_a_fake_device_and_exits_0(devices):
+    imu_dev, dgps_dev = devices
+    with ros_node('probe_imu_gps_process') as (probe, executor):
+        imu = []
+        probe.create_subscription(Imu, 'imu/data', imu.append, SENSOR_QOS)
+        proc = NodeProcess('dukw_driver', 'imu_gps_node', [
+            '--ros-args', '-p', f'mavlink.port:={imu_dev.path}', '-p',
+            f'nmea.port:={dgps_dev.path}'])
+        try:
+            assert spin_until(executor, lambda: imu, timeout_s=20), proc.stderr
+        finally:
+            code = proc.stop()
+    assert code == 0, proc.stderr
+    assert 'Traceback' not in proc.stderr

@@ -8,8 +8,8 @@ import pytest
 from dukw_msgs.msg import Depth, WaterContact
 
 from dukw_common.config import ConfigError
-from dukw_common.node_tools import parameter_overrides
-from dukw_common.testing import ros_node
+from dukw_common.node_tools import SENSOR_QOS, parameter_overrides
+from dukw_common.testing import NodeProcess, ros_node, spin_until
 from dukw_driver.nmea_stream import nmea_sentence
 from dukw_driver.water_sensor_node import WaterSensorNode
 from fake_device import FakeDevice
@@ -156,3 +156,20 @@ def test_bad_parameters_are_refused_naming_them(overrides, name):
         with pytest.raises(ConfigError, match=re.escape(name)):
             WaterSensorNode(context=probe.context,
                             parameter_overrides=parameter_overrides(overrides))
+
+
+def test_installed_executable_publishes_from_fake_devices_and_exits_0(fakes):
+    _, adc_dev, _, sounder_dev = fakes
+    with ros_node('probe_water_process') as (probe, executor):
+        contact, depth = [], []
+        probe.create_subscription(WaterContact, 'water/contact', contact.append, SENSOR_QOS)
+        probe.create_subscription(Depth, 'depth', depth.append, SENSOR_QOS)
+        proc = NodeProcess('dukw_driver', 'water_sensor_node', [
+            '--ros-args', '-p', f'adc.port:={adc_dev.path}', '-p',
+            f'sounder.port:={sounder_dev.path}'])
+        try:
+            assert spin_until(executor, lambda: contact and depth, timeout_s=20), proc.stderr
+        finally:
+            code = proc.stop()
+    assert code == 0, proc.stderr
+    assert 'Traceback' not in proc.stderr
