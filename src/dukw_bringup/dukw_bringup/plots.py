@@ -196,14 +196,14 @@ def plot_modes(run: RunData, ctx: PlotContext, path: Path) -> Path:
     fig, (mode_ax, speed_ax, cmd_ax) = _figure(3, ctx.title or 'drive mode')
     modes = run.get('drive_mode')
     if modes is not None:
-        mode_ax.step(modes.t_s, modes['mode'], where='post')
+        mode_ax.step(modes.t_s, modes['mode'], where='post', label='drive_mode')
     else:
         _no_data(mode_ax, 'drive_mode')
     truth = run.get('sim/truth')
     if truth is not None:
         mode_ax.step(truth.t_s, truth['medium'], where='post', ls='--', alpha=0.6,
                      label='true medium (LAND/TRANSITION/WATER)')
-        _legend(mode_ax)
+    _legend(mode_ax)
     mode_ax.set_yticks(list(MODE_NAMES), list(MODE_NAMES.values()))
     for topic, column, label in (('odometry/filtered', 'speed_mps', 'EKF surge speed'),
                                  ('sim/truth', 'surge_mps', 'true surge speed'),
