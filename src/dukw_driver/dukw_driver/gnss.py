@@ -105,16 +105,28 @@ def parse_source(value: object, name: str) -> GnssSource:
 
 
 class SourcePreference:
-    """Take one receiver's data; fall back to the other only while the preferred one is silent."""
+    """Take one receiver's data; use the other only while the preferred one has nothing usable.
+
+    "Usable" is a fix with a position (a NO_FIX report is not), or any velocity. A
+    preferred receiver's unusable data is still published while the other has had
+    nothing usable either, so subscribers see the no-fix status.
+    """
 
     def __init__(self, preferred: GnssSource, fallback_after_s: float) -> None:
         self.preferred = preferred
         self.fallback_after_s = fallback_after_s
         self._last_preferred_s = -math.inf
+        self._last_fallback_s = -math.inf
 
-    def accept(self, source: GnssSource, now_s: float) -> bool:
+    def accept(self, source: GnssSource, now_s: float, usable: bool = True) -> bool:
         """True if data from ``source`` arriving at ``now_s`` should be published."""
         if source == self.preferred:
-            self._last_preferred_s = now_s
-            return True
-        return now_s - self._last_preferred_s > self.fallback_after_s
+            if usable:
+                self._last_preferred_s = now_s
+                return True
+            return now_s - self._last_fallback_s > self.fallback_after_s
+        if now_s - self._last_preferred_s <= self.fallback_after_s:
+            return False
+        if usable:
+            self._last_fallback_s = now_s
+        return True

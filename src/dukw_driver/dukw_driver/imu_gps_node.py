@@ -16,7 +16,7 @@ from sensor_msgs.msg import Imu, NavSatFix, NavSatStatus
 from dukw_common.node_tools import (SENSOR_QOS, ParamSpec, declare_parameters, diagnostic_array,
                                     run_node)
 from dukw_driver.device_channel import DeviceChannel, link_from_params, require_name
-from dukw_driver.gnss import (GpsFix, GpsVelocity, SourcePreference, UereSettings,
+from dukw_driver.gnss import (FixStatus, GpsFix, GpsVelocity, SourcePreference, UereSettings,
                               parse_source)
 from dukw_driver.mavlink_imu import ImuSample, ImuSettings, MavlinkImuDecoder
 from dukw_driver.nmea_gps import GpsNmeaDecoder, NmeaGpsSettings
@@ -88,7 +88,8 @@ class ImuGpsNode(Node):
             for item in device.poll(now_s):
                 if isinstance(item, ImuSample):
                     self.imu_pub.publish(self._imu(item, stamp))
-                elif isinstance(item, GpsFix) and self.fix_pref.accept(item.source, now_s):
+                elif isinstance(item, GpsFix) and self.fix_pref.accept(
+                        item.source, now_s, usable=item.status != FixStatus.NO_FIX):
                     self.fix_pub.publish(self._fix(item, stamp))
                 elif isinstance(item, GpsVelocity) and self.vel_pref.accept(item.source, now_s):
                     self.vel_pub.publish(self._vel(item, stamp))

@@ -114,6 +114,14 @@ def test_source_preference_falls_back_only_while_the_preferred_is_silent():
     assert pref.accept(GnssSource.NMEA, 1.0)
     assert not pref.accept(GnssSource.MAVLINK, 2.5)
     assert pref.accept(GnssSource.MAVLINK, 3.5)          # DGPS silent for 2.5 s
+    # the DGPS reports 'no fix': the IMU's GPS keeps filling in, the no-fix is not published
+    assert not pref.accept(GnssSource.NMEA, 4.0, usable=False)
+    assert pref.accept(GnssSource.MAVLINK, 4.1)
+    assert pref.accept(GnssSource.NMEA, 4.5)             # the DGPS has its fix back
+    assert not pref.accept(GnssSource.MAVLINK, 4.6)
+    # nobody has a fix: the preferred receiver's no-fix is published
+    lone = SourcePreference(GnssSource.NMEA, fallback_after_s=2.0)
+    assert lone.accept(GnssSource.NMEA, 0.0, usable=False)
     assert parse_source('mavlink', 'x') == GnssSource.MAVLINK
     with pytest.raises(ConfigError, match='fix_source'):
         parse_source('glonass', 'fix_source')
