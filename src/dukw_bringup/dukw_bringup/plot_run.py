@@ -25,6 +25,8 @@ from dukw_common.vehicle import Vehicle
 
 BAG_DIR = 'bag'
 SUMMARY_FILE = 'summary.json'
+#: what main_job adds to the summary and a later plot_run keeps
+RUN_KEYS = ('ending', 'exit_code', 'real_time_factor', 'wall_time_s')
 MISSION_COPY = 'mission.yaml'
 CONFIG_COPY = 'dukw.yaml'
 
@@ -38,10 +40,24 @@ def run_files(run_dir: Path) -> tuple[Path, Path]:
     return config, mission
 
 
+def previous_run_keys(path: Path) -> dict[str, Any]:
+    """RUN_KEYS of an earlier summary.json ({} if there is none or it is unreadable)."""
+    try:
+        previous = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return {}
+    return {k: previous[k] for k in RUN_KEYS if isinstance(previous, dict) and k in previous}
+
+
 def render_run(run_dir: str | Path, wall_time_s: float | None = None,
                extra: dict[str, Any] | None = None) -> dict[str, Any]:
-    """Read the run's bag, write summary.json and the plots; return the summary."""
+    """Read the run's bag, write summary.json and the plots; return the summary.
+
+    Without ``extra``, the main job's own keys (RUN_KEYS) of an existing summary stay.
+    """
     run_dir = Path(run_dir)
+    if extra is None:
+        extra = previous_run_keys(run_dir / SUMMARY_FILE)
     config_path, mission_path = run_files(run_dir)
     vehicle = Vehicle.load(str(config_path))
     sim = node_params('sim_node', config_path)
@@ -49,7 +65,7 @@ def render_run(run_dir: str | Path, wall_time_s: float | None = None,
     run = load_run(run_dir / BAG_DIR)
     limit_a = vehicle.drivetrain.continuous_current_limit_a
     summary = summarize_run(run, limit_a, mission.name, wall_time_s)
-    summary.update(extra or {})
+    summary.update(extra)
     info = summarize(run_dir / BAG_DIR)
     summary['bag'] = BAG_DIR
     summary['bag_messages'] = info.message_count

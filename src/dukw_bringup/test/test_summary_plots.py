@@ -98,6 +98,10 @@ def test_plot_run_writes_summary_and_every_plot(tmp_path, capsys):
     for key in ('reached', 'time_s', 'mode_timeline', 'track_currents', 'slip', 'submersion'):
         assert key in summary
     assert summary['bag_topics']['/tracks/status'] == 201
+    summary['ending'] = 'mission done'                 # as main_job writes it
+    (tmp_path / 'summary.json').write_text(json.dumps(summary))
+    assert plot_run_main([str(tmp_path)]) == 0
+    assert json.loads((tmp_path / 'summary.json').read_text())['ending'] == 'mission done'
     for name in PLOT_FILES:
         png = (tmp_path / name).read_bytes()
         assert png.startswith(b'\x89PNG') and len(png) > 10_000, name
