@@ -1,0 +1,50 @@
+"""The whole stack on the simulator: sim_node, ekf_node and the two control nodes as
+processes drive the vehicle from the sand into the sea on a cmd_vel of 1 m/s."""
+import itertools
+import time
+
+import pytest
+from dukw_msgs.msg import DriveMode, SimTruth
+from geometry_msgs.msg import Twist
+
+from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS
+from dukw_common.testing import NodeProcess, ros_node
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+
+SIM_TIME = ['--ros-args', '-p', 'use_sim_time:=true']
+
+
+def test_sand_to_sea_on_a_cmd_vel_of_1_mps():
+    with ros_node('stack_probe') as (node, executor):
+        truths, modes = [], []
+        node.create_subscription(SimTruth, 'sim/truth', truths.append, SENSOR_QOS)
+        node.create_subscription(DriveMode, 'drive_mode', modes.append, STATE_QOS)
+        cmd_vel = node.create_publisher(Twist, 'cmd_vel', COMMAND_QOS)
+        request = Twist()
+        request.linear.x = 1.0
+        node.create_timer(0.05, lambda: cmd_vel.publish(request))
+        procs = [NodeProcess('dukw_sim', 'sim_node', ['--ros-args', '-p', 'real_time_factor:=1.0',
+                                                      '-p', 'waves.model:=irregular']),
+                 NodeProcess('dukw_estimation', 'ekf_node', SIM_TIME),
+                 NodeProcess('dukw_control', 'mode_manager_node', SIM_TIME),
+                 NodeProcess('dukw_control', 'drive_controller_node', SIM_TIME)]
+        try:
+            deadline = time.monotonic() + 150.0
+            while time.monotonic() < deadline and not (truths and truths[-1].x_m > 12.0):
+                executor.spin_once(timeout_sec=0.05)
+        finally:
+            codes = [p.stop() for p in procs]
+    errors = '\n'.join(p.stderr[-2000:] for p in procs)
+    assert truths and truths[-1].x_m > 12.0, errors
+    assert codes == [0, 0, 0, 0], errors
+    changes = [next(group) for _, group in itertools.groupby(modes, key=lambda m: m.mode)]
+    sequence = [m.mode for m in changes]
+    why = [(m.mode, m.reason) for m in changes]
+    assert sequence[-3:] == [DriveMode.LAND, DriveMode.TRANSITION, DriveMode.WATER], why
+    assert DriveMode.LAND not in sequence[:-3] and DriveMode.WATER not in sequence[:-3]
+    assert truths[-1].medium == SimTruth.MEDIUM_WATER
+    last_s = truths[-1].header.stamp.sec
+    recent = [t.surge_mps for t in truths if t.header.stamp.sec >= last_s - 4]
+    assert 0.7 < sum(recent) / len(recent) < 1.3
+    assert abs(truths[-1].y_m) < 2.0
