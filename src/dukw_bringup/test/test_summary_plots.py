@@ -12,6 +12,7 @@ from std_msgs.msg import String
 from dukw_bringup.bag_io import BagWriter
 from dukw_bringup.mission import MissionState, Progress
 from dukw_bringup.plot_run import main as plot_run_main
+from dukw_bringup.plot_run import previous_run_keys
 from dukw_bringup.plots import PLOT_FILES
 from dukw_bringup.summary import load_run, summarize_run, time_average
 
@@ -98,10 +99,15 @@ def test_plot_run_writes_summary_and_every_plot(tmp_path, capsys):
     for key in ('reached', 'time_s', 'mode_timeline', 'track_currents', 'slip', 'submersion'):
         assert key in summary
     assert summary['bag_topics']['/tracks/status'] == 201
-    summary['ending'] = 'mission done'                 # as main_job writes it
-    (tmp_path / 'summary.json').write_text(json.dumps(summary))
-    assert plot_run_main([str(tmp_path)]) == 0
-    assert json.loads((tmp_path / 'summary.json').read_text())['ending'] == 'mission done'
+
+
+
+def test_plot_run_keeps_the_main_jobs_keys_of_an_earlier_summary(tmp_path):
+    (tmp_path / 'summary.json').write_text(json.dumps({'ending': 'mission done', 'x': 1}))
+    assert previous_run_keys(tmp_path / 'summary.json') == {'ending': 'mission done'}
+    (tmp_path / 'summary.json').write_text('{not json')
+    assert previous_run_keys(tmp_path / 'summary.json') == {}
+    assert previous_run_keys(tmp_path / 'none.json') == {}
     for name in PLOT_FILES:
         png = (tmp_path / name).read_bytes()
         assert png.startswith(b'\x89PNG') and len(png) > 10_000, name
