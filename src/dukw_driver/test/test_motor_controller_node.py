@@ -32,6 +32,9 @@ class Graph(NodeGraph):
     def connected(self):
         return bool(self.msgs) and self.msgs[-1].connected
 
+    def spin_until(self, predicate, timeout_s=10.0):
+        return super().spin_until(predicate, timeout_s)
+
     def level(self):
         status = self.status('controller')
         return None if status is None else status.level
@@ -74,7 +77,7 @@ def test_unplug_reports_the_loss_and_replug_publishes_again(tracks, roboteq):
     assert lost.port.fault_flags & MotorSide.FAULT_COMM_TIMEOUT
     assert tracks.spin_until(lambda: tracks.level() == DiagnosticStatus.ERROR
                              and 'not connected' in tracks.status('controller').message,
-                             timeout_s=3.0)
+                             timeout_s=10.0)
     count = len(tracks.msgs)
     tracks.spin_until(lambda: False, timeout_s=1.0)
     assert len(tracks.msgs) > count  # keeps publishing while the device is away
