@@ -4,7 +4,7 @@ from __future__ import annotations
 from dukw_common.geometry import euler_from_quaternion
 from dukw_msgs.msg import Authority, DiffCommand, DriveMode
 
-from dukw_control.mixer import SidePair
+from dukw_control.mixer import NEUTRAL, SidePair
 from dukw_control.modes import Mode, ModeDecision
 
 #: Authority reasons that hold the outputs at neutral whoever holds authority.
@@ -52,6 +52,25 @@ def diff_command(sides: SidePair, stamp, frame_id: str = 'base_link') -> DiffCom
     msg.header.stamp = stamp
     msg.header.frame_id = frame_id
     return msg
+
+
+class ActuatorPublishers:
+    """The pair every commanding node has: tracks/cmd and props/cmd (reliable)."""
+
+    def __init__(self, node, qos) -> None:
+        self.node = node
+        self.tracks = node.create_publisher(DiffCommand, 'tracks/cmd', qos)
+        self.props = node.create_publisher(DiffCommand, 'props/cmd', qos)
+
+    def publish(self, tracks: SidePair, props: SidePair) -> None:
+        """Both commands with one stamp of the node's clock."""
+        stamp = self.node.get_clock().now().to_msg()
+        self.tracks.publish(diff_command(tracks, stamp))
+        self.props.publish(diff_command(props, stamp))
+
+    def neutral(self) -> None:
+        """Neutral on both actuators (a node's last word)."""
+        self.publish(NEUTRAL, NEUTRAL)
 
 
 def pitch_from_imu(msg) -> float:

@@ -4,7 +4,7 @@ A thin shell around dukw_control.controller.DriveController: it converts message
 runs the core at ``rate_hz`` and publishes the commands (neutral on shutdown).
 """
 from diagnostic_msgs.msg import DiagnosticArray
-from dukw_msgs.msg import Authority, DiffCommand, DrivetrainStatus, DriveMode, Traction
+from dukw_msgs.msg import Authority, DrivetrainStatus, DriveMode, Traction
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
@@ -15,9 +15,8 @@ from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpe
                                     declare_parameters, diagnostic_array, run_node,
                                     vehicle_specs)
 from dukw_control.controller import NODE_PARAMS, DriveController, settings_from_params
-from dukw_control.convert import (authority_usable, decision_from_msg, diff_command,
+from dukw_control.convert import (ActuatorPublishers, authority_usable, decision_from_msg,
                                   pitch_from_imu)
-from dukw_control.mixer import NEUTRAL
 
 
 class DriveControllerNode(Node):
@@ -32,8 +31,7 @@ class DriveControllerNode(Node):
             self.core = DriveController(settings_from_params(params))
         except ValueError as exc:
             raise ConfigError(f'drive_controller_node: {exc}') from exc
-        self.tracks_pub = self.create_publisher(DiffCommand, 'tracks/cmd', COMMAND_QOS)
-        self.props_pub = self.create_publisher(DiffCommand, 'props/cmd', COMMAND_QOS)
+        self.commands = ActuatorPublishers(self, COMMAND_QOS)
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
         self.create_subscription(Twist, 'cmd_vel', self.on_cmd_vel, COMMAND_QOS)
         self.create_subscription(Authority, 'authority', self.on_authority, STATE_QOS)
@@ -85,9 +83,7 @@ class DriveControllerNode(Node):
 
     def on_timer(self) -> None:
         out = self.core.step(self.now_s())
-        stamp = self.get_clock().now().to_msg()
-        self.tracks_pub.publish(diff_command(out.tracks, stamp))
-        self.props_pub.publish(diff_command(out.props, stamp))
+        self.commands.publish(out.tracks, out.props)
         if out.neutral_reason != self.last_reason:
             self.last_reason = out.neutral_reason
             if out.neutral_reason:
@@ -101,9 +97,7 @@ class DriveControllerNode(Node):
 
     def on_shutdown(self) -> None:
         """Last word: neutral on both actuators."""
-        stamp = self.get_clock().now().to_msg()
-        self.tracks_pub.publish(diff_command(NEUTRAL, stamp))
-        self.props_pub.publish(diff_command(NEUTRAL, stamp))
+        self.commands.neutral()
 
 
 def main(args=None) -> int:

@@ -5,7 +5,7 @@ applied, and ends with neutral: when finished, at once when the RC operator take
 over, or when a limit trips (incline, track current allowance). Records nothing
 (record with the bag recorder). Exits when done.
 """
-from dukw_msgs.msg import Authority, DiffCommand, DrivetrainStatus
+from dukw_msgs.msg import Authority, DrivetrainStatus
 from rclpy.node import Node
 from sensor_msgs.msg import Imu
 
@@ -13,11 +13,10 @@ from dukw_common.config import ConfigError
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
                                     declare_parameters, run_node, vehicle_specs)
 from dukw_common.vehicle import drivetrain_params, limit_params
-from dukw_control.convert import authority_usable, diff_command, pitch_from_imu
+from dukw_control.convert import ActuatorPublishers, authority_usable, pitch_from_imu
 from dukw_control.guards import InclineGuard
 from dukw_control.limits import CurrentLimiter, CurrentLimitSettings
 from dukw_control.maneuvers import ManeuverPlan, ManeuverPlayer, PlayerState
-from dukw_control.mixer import NEUTRAL
 
 SPECS = [
     ParamSpec('rate_hz', 'command rate, Hz', 1.0, 1000.0),
@@ -64,8 +63,7 @@ class ManeuverNode(Node):
         self.start_s = self.last_s = self.now_s()
         self.status_s = None
         self.end_s = None
-        self.tracks_pub = self.create_publisher(DiffCommand, 'tracks/cmd', COMMAND_QOS)
-        self.props_pub = self.create_publisher(DiffCommand, 'props/cmd', COMMAND_QOS)
+        self.commands = ActuatorPublishers(self, COMMAND_QOS)
         self.create_subscription(Authority, 'authority', self.on_authority, STATE_QOS)
         self.create_subscription(Imu, 'imu/data', self.on_imu, SENSOR_QOS)
         self.create_subscription(DrivetrainStatus, 'tracks/status', self.on_tracks, SENSOR_QOS)
@@ -102,9 +100,7 @@ class ManeuverNode(Node):
             player.abort('tracks/status stale: the current limit cannot be watched')
         before = player.state
         tracks, props = player.step(now, self.usable, self.incline_rad, dt)
-        stamp = self.get_clock().now().to_msg()
-        self.tracks_pub.publish(diff_command(tracks, stamp))
-        self.props_pub.publish(diff_command(props, stamp))
+        self.commands.publish(tracks, props)
         if player.state != before:
             text = player.state.value + (f': {player.reason}' if player.reason else '')
             if player.state == PlayerState.ABORTED:
@@ -118,9 +114,7 @@ class ManeuverNode(Node):
 
     def on_shutdown(self) -> None:
         """Last word: neutral on both actuators."""
-        stamp = self.get_clock().now().to_msg()
-        self.tracks_pub.publish(diff_command(NEUTRAL, stamp))
-        self.props_pub.publish(diff_command(NEUTRAL, stamp))
+        self.commands.neutral()
 
 
 def main(args=None) -> int:
