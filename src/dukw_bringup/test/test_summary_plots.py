@@ -99,7 +99,9 @@ def test_plot_run_writes_summary_and_every_plot(tmp_path, capsys):
     for key in ('reached', 'time_s', 'mode_timeline', 'track_currents', 'slip', 'submersion'):
         assert key in summary
     assert summary['bag_topics']['/tracks/status'] == 201
-
+    for name in PLOT_FILES:
+        png = (tmp_path / name).read_bytes()
+        assert png.startswith(b'\x89PNG') and len(png) > 10_000, name
 
 
 def test_plot_run_keeps_the_main_jobs_keys_of_an_earlier_summary(tmp_path):
@@ -108,9 +110,6 @@ def test_plot_run_keeps_the_main_jobs_keys_of_an_earlier_summary(tmp_path):
     (tmp_path / 'summary.json').write_text('{not json')
     assert previous_run_keys(tmp_path / 'summary.json') == {}
     assert previous_run_keys(tmp_path / 'none.json') == {}
-    for name in PLOT_FILES:
-        png = (tmp_path / name).read_bytes()
-        assert png.startswith(b'\x89PNG') and len(png) > 10_000, name
 
 
 def test_plot_run_on_a_folder_without_bag_is_a_clear_error(tmp_path, capsys):
