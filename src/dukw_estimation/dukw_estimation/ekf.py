@@ -3,7 +3,8 @@
 State (``Idx``): odom position x, y; yaw; body surge u, sway v; yaw rate r; gyro-z bias;
 waterline distance s (along the slope, base_link seaward of the mean waterline); wave
 elevation eta at the vehicle and its rate (a noise-driven damped oscillator at the sea's
-peak frequency).
+peak frequency); the DGPS position error east/north (first-order Gauss-Markov), so that
+its slow drift is not taken for motion.
 
 Predict and update are written with numpy directly rather than through filterpy's
 generic ``ExtendedKalmanFilter``: its update cannot gate an innovation before applying it
@@ -34,9 +35,13 @@ class Idx(IntEnum):
     S = 7
     ETA = 8
     ETA_RATE = 9
+    GPS_BIAS_E = 10
+    GPS_BIAS_N = 11
 
 
 N_STATES = len(Idx)
+#: The states the water-contact and depth measurements may correct.
+SURFACE_STATES = np.array([1.0 if i in (Idx.S, Idx.ETA, Idx.ETA_RATE) else 0.0 for i in Idx])
 
 
 class Outcome(Enum):
@@ -62,6 +67,8 @@ class ProcessNoise:
     wave_omega_rps: float
     wave_damping: float
     wave_sigma_m: float
+    gps_bias_sigma_m: float = 0.0
+    gps_bias_tau_s: float = 1.0
 
     def wave_drive(self) -> float:
         """Spectral density driving the oscillator so that its stationary sigma is wave_sigma."""
@@ -130,10 +137,15 @@ class MotionEkf:
         F[Idx.ETA, Idx.ETA_RATE] = dt
         F[Idx.ETA_RATE, Idx.ETA] = -w * w * dt
         F[Idx.ETA_RATE, Idx.ETA_RATE] = 1.0 - 2.0 * z * w * dt
+        decay = 1.0 - dt / n.gps_bias_tau_s
+        x[Idx.GPS_BIAS_E] *= decay
+        x[Idx.GPS_BIAS_N] *= decay
+        F[Idx.GPS_BIAS_E, Idx.GPS_BIAS_E] = F[Idx.GPS_BIAS_N, Idx.GPS_BIAS_N] = decay
+        bias_q = 2.0 * n.gps_bias_sigma_m ** 2 / n.gps_bias_tau_s
         accel = n.accel_mps2 if accel_noise_mps2 is None else accel_noise_mps2
         q = np.array([n.position_m ** 2, n.position_m ** 2, n.yaw_rad ** 2, accel ** 2,
                       accel ** 2, n.yaw_accel_rps2 ** 2, n.gyro_bias_rps ** 2,
-                      n.waterline_m ** 2, 0.0, n.wave_drive()]) * dt
+                      n.waterline_m ** 2, 0.0, n.wave_drive(), bias_q, bias_q]) * dt
         P = F @ self.P @ F.T
         P[np.diag_indices(N_STATES)] += q
         self.P = P
@@ -161,8 +173,14 @@ class MotionEkf:
         return Outcome.ACCEPTED
 
     def update_scalar(self, z: float, hx: float, h: np.ndarray, var: float,
-                      gate: float, angle: bool = False) -> Outcome:
-        """Gated update with one scalar measurement; ``h`` is the Jacobian row."""
+                      gate: float, angle: bool = False,
+                      only: np.ndarray | None = None) -> Outcome:
+        """Gated update with one scalar measurement; ``h`` is the Jacobian row.
+
+        ``only`` (a 0/1 mask) restricts the correction to some states (a Schmidt / consider
+        update): the water-contact and depth models may move the waterline distance and the
+        wave but must not push the motion states through their correlations.
+        """
         y = z - hx
         if angle:
             y = wrap_angle(y)
@@ -171,9 +189,12 @@ class MotionEkf:
         if not s > 0.0 or y * y > gate * gate * s:
             return Outcome.REJECTED_OUTLIER
         k = Ph / s
+        if only is not None:
+            k = k * only
         self.x += k * y
         self.x[Idx.YAW] = wrap_angle(self.x[Idx.YAW])
-        # Joseph form for one row: (I - k h) P (I - k h)^T + k var k^T
+        # Joseph form for one row, valid for any gain k:
+        # (I - k h) P (I - k h)^T + k var k^T = P - k Ph^T - Ph k^T + k k^T (h P h + var)
         kh_p = np.outer(k, Ph)
         self.P = self.P - kh_p - kh_p.T + np.outer(k, k) * s
         return Outcome.ACCEPTED

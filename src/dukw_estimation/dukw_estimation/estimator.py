@@ -7,6 +7,7 @@ filter goes on predicting without it (robot_localization's behaviour).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections import defaultdict
 
@@ -16,7 +17,8 @@ from dukw_common.diagnostics import Health, Level, RateCounter
 from dukw_common.geometry import local_enu_from_geodetic, wrap_angle
 from dukw_common.vehicle import SoilParams, Vehicle
 from dukw_estimation import buoyancy, traction
-from dukw_estimation.ekf import N_STATES, Idx, MotionEkf, Outcome, ProcessNoise
+from dukw_estimation.ekf import (N_STATES, SURFACE_STATES, Idx, MotionEkf, Outcome,
+                                 ProcessNoise)
 from dukw_estimation.force_filter import ForceSmoother
 from dukw_estimation.samples import (DepthReading, DriveStatus, GpsFix, GpsVelocity,
                                      ImuSample, OdometryEstimate, TractionEstimate,
@@ -24,7 +26,8 @@ from dukw_estimation.samples import (DepthReading, DriveStatus, GpsFix, GpsVeloc
 from dukw_estimation.settings import SENSORS, EkfSettings
 
 MAX_PREDICT_STEP_S = 0.02
-GROUNDED_FRACTION = 0.5          # above this weight share the pitch is the beach slope
+GROUNDED_FRACTION = 0.5          # above this weight share the tracks drive the vehicle
+SLOPE_FRACTION = 0.9             # above this share the pitch is the beach's, not the waves'
 FRACTION_PERIOD_S = 0.1          # how often the IMU path refreshes the weight share
 
 
@@ -41,6 +44,11 @@ class Estimator:
         self.hull_bow_x_m = min(0.5 * body.hull_length_m, body.bow_x_m)
         self.hull_stern_x_m = max(-0.5 * body.hull_length_m, body.stern_x_m)
         self.track_area_m2 = body.track_width_m * body.track_contact_length_m
+        hull_length = self.hull_bow_x_m - self.hull_stern_x_m
+        self.full_volume_m3 = 2.0 * math.pi * body.hull_radius_m ** 2 * hull_length
+        self.heave_mass_kg = buoyancy.heave_mass_kg(
+            body.displaced_volume_m3, body.hull_radius_m, hull_length, body.water_density_kgpm3,
+            body.gravity_mps2, settings.heave_natural_hz)
         self.counters: dict[str, dict[Outcome, int]] = {s: defaultdict(int) for s in SENSORS}
         self.rates = {s: RateCounter() for s in SENSORS}
         self.reset()
@@ -53,11 +61,12 @@ class Estimator:
                        st.init_velocity_mps ** 2, st.init_velocity_mps ** 2,
                        st.init_yaw_rate_rps ** 2, st.init_gyro_bias_rps ** 2,
                        st.waterline_sigma_m ** 2, st.wave_sigma_m ** 2 + 1e-6,
-                       (st.wave_sigma_m * 2 * math.pi * st.wave_peak_frequency_hz) ** 2 + 1e-6])
+                       (st.wave_sigma_m * 2 * math.pi * st.wave_peak_frequency_hz) ** 2 + 1e-6,
+                       st.gps_bias_sigma_m ** 2, st.gps_bias_sigma_m ** 2])
         noise = ProcessNoise(st.q_position_m, st.q_yaw_rad, st.q_accel_mps2, st.q_yaw_accel_rps2,
                              st.q_gyro_bias_rps, st.q_waterline_m,
                              2 * math.pi * st.wave_peak_frequency_hz, st.wave_damping_ratio,
-                             st.wave_sigma_m)
+                             st.wave_sigma_m, st.gps_bias_sigma_m, st.gps_bias_tau_s)
         self.ekf = MotionEkf(np.zeros(N_STATES), p0, noise, st.seaward_yaw_rad)
         self.t_s: float | None = None
         self.last_t = {s: -math.inf for s in SENSORS}
@@ -118,9 +127,12 @@ class Estimator:
         noise = None
         target = None
         if imu is not None and self._fresh('imu', now) and math.isfinite(imu.accel_x_mps2):
-            g = self.vehicle.body.gravity_mps2
-            accel = (imu.accel_x_mps2 + g * math.sin(imu.pitch_rad) + x[Idx.R] * x[Idx.V],
-                     imu.accel_y_mps2 - g * math.sin(imu.roll_rad) * math.cos(imu.pitch_rad)
+            # gravity along the body axes from the attitude, scaled by the measured vertical
+            # specific force (heave accelerations afloat): g_up = f_z / (cos roll cos pitch)
+            tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
+            g_up = imu.accel_z_mps2 / max(tilt, 0.5)
+            accel = (imu.accel_x_mps2 + g_up * math.sin(imu.pitch_rad) + x[Idx.R] * x[Idx.V],
+                     imu.accel_y_mps2 - g_up * math.sin(imu.roll_rad) * math.cos(imu.pitch_rad)
                      - x[Idx.R] * x[Idx.U])
         else:
             noise = st.q_accel_no_imu_mps2
@@ -166,7 +178,7 @@ class Estimator:
         if rejected:
             return rejected
         dt = s.t_s - self.imu.t_s if self.imu is not None else 0.0
-        self.imu = s
+        self.imu = self._imu_at_base_link(s, dt)
         st = self.settings
         h = np.zeros(N_STATES)
         h[Idx.R] = h[Idx.BIAS] = 1.0
@@ -187,11 +199,30 @@ class Estimator:
         self._update_slope(s, dt)
         return self._count('imu', out)
 
+    def _imu_at_base_link(self, s: ImuSample, dt: float) -> ImuSample:
+        """Move the specific force from the IMU (sensors.imu_z_m above base_link) to base_link.
+
+        A point at r = (0, 0, h) feels alpha x r + w x (w x r) more than base_link; alpha comes
+        from differencing the gyro (roll and pitch rates), which matters afloat.
+        """
+        h = self.vehicle.sensors.imu_z_m
+        prev = self.imu
+        if prev is not None and 0.0 < dt <= MAX_PREDICT_STEP_S * 5:
+            alpha_x = (s.roll_rate_rps - prev.roll_rate_rps) / dt
+            alpha_y = (s.pitch_rate_rps - prev.pitch_rate_rps) / dt
+        else:
+            alpha_x = alpha_y = 0.0
+        wx, wy, wz = s.roll_rate_rps, s.pitch_rate_rps, s.yaw_rate_rps
+        return dataclasses.replace(
+            s, accel_x_mps2=s.accel_x_mps2 - (alpha_y + wz * wx) * h,
+            accel_y_mps2=s.accel_y_mps2 + (alpha_x - wz * wy) * h,
+            accel_z_mps2=s.accel_z_mps2 + (wx * wx + wy * wy) * h)
+
     def _update_slope(self, s: ImuSample, dt: float) -> None:
         """Low-pass the beach slope along the seaward direction from pitch and roll."""
         if s.t_s - self._fraction_t_s >= FRACTION_PERIOD_S:
             self.traction()          # refreshes the weight share
-        if self.fraction <= GROUNDED_FRACTION:
+        if self.fraction <= SLOPE_FRACTION:
             return
         rel = self.ekf.x[Idx.YAW] - self.settings.seaward_yaw_rad
         measured = s.pitch_rad * math.cos(rel) + s.roll_rad * math.sin(rel)
@@ -227,12 +258,15 @@ class Estimator:
             self._init_waterline()
             self.position_set = True
         H = np.zeros((2, N_STATES))
-        H[0, Idx.X] = H[1, Idx.Y] = 1.0
+        H[0, Idx.X] = H[1, Idx.Y] = H[0, Idx.GPS_BIAS_E] = H[1, Idx.GPS_BIAS_N] = 1.0
         H[0, Idx.YAW] = -sn * a + c * b
         H[1, Idx.YAW] = c * a + sn * b
-        var = s.horizontal_var_m2 if s.horizontal_var_m2 > 0 else self.settings.gps_position_m ** 2
-        out = self.ekf.update(np.array([east, north]), x[[Idx.X, Idx.Y]] + offset, H,
-                              np.eye(2) * var, self.settings.gate_gps_fix)
+        # with bias states the message's covariance (the total error) is not the white part
+        var = s.horizontal_var_m2 if s.horizontal_var_m2 > 0 and self.settings.gps_bias_sigma_m \
+            == 0.0 else self.settings.gps_position_m ** 2
+        predicted = x[[Idx.X, Idx.Y]] + offset + x[[Idx.GPS_BIAS_E, Idx.GPS_BIAS_N]]
+        out = self.ekf.update(np.array([east, north]), predicted, H, np.eye(2) * var,
+                              self.settings.gate_gps_fix)
         return self._count('gps_fix', out)
 
     def add_gps_velocity(self, s: GpsVelocity) -> Outcome:
@@ -267,7 +301,7 @@ class Estimator:
             if bool(wet) == (depth > 0.0):
                 continue
             result = self.ekf.update_scalar(0.0, depth, h, self.settings.contact_m ** 2,
-                                            self.settings.gate_water)
+                                            self.settings.gate_water, only=SURFACE_STATES)
             if out is not Outcome.REJECTED_OUTLIER:
                 out = result
         if out is Outcome.IGNORED:
@@ -305,7 +339,7 @@ class Estimator:
         floor_depth = min(floor_depth, site.sea_floor_depth_m)
         predicted = x[Idx.ETA] - body.draft_m + mounts.depth_sounder_z_m + floor_depth
         out = self.ekf.update_scalar(s.depth_m, predicted, h, self.settings.depth_m ** 2,
-                                     self.settings.gate_depth)
+                                     self.settings.gate_depth, only=SURFACE_STATES)
         return self._count('depth', out)
 
     def add_tracks(self, s: DriveStatus) -> Outcome:
@@ -373,9 +407,10 @@ class Estimator:
         h2 = buoyancy.submerged_length_m(*args, x[Idx.ETA], heading_cos)
         volume = buoyancy.grounded_volume_m3(*args, body.hull_radius_m, x[Idx.ETA], heading_cos)
         afloat = volume >= body.displaced_volume_m3
-        volume = min(volume, body.displaced_volume_m3)
-        weight = traction.effective_weight_n(body.displacement_n, volume, slope,
-                                             body.water_density_kgpm3, body.gravity_mps2)
+        if afloat:
+            volume = self._afloat_volume()
+        weight = 0.0 if afloat else traction.effective_weight_n(
+            body.displacement_n, volume, slope, body.water_density_kgpm3, body.gravity_mps2)
         self.fraction = weight / (body.displacement_n * math.cos(slope))
         self._fraction_t_s = self.t_s or 0.0
         half = 0.5 * body.hull_separation_m
@@ -393,6 +428,20 @@ class Estimator:
                                 self.fraction, float(x[Idx.S]), h2, slope, predicted[0],
                                 predicted[1], self.force[0].force_n, self.force[1].force_n,
                                 afloat, float(x[Idx.ETA]))
+
+    def _afloat_volume(self) -> float:
+        """Floating: the displacement, plus what the heave acceleration says (IMU fresh)."""
+        body = self.vehicle.body
+        imu = self.imu
+        if imu is None or not math.isfinite(imu.accel_z_mps2) or self.t_s is None \
+                or not self._fresh('imu', self.t_s):
+            return body.displaced_volume_m3
+        tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
+        heave_accel = imu.accel_z_mps2 / max(tilt, 0.5) - body.gravity_mps2
+        volume = buoyancy.afloat_dynamic_volume_m3(body.displacement_n, self.heave_mass_kg,
+                                                   heave_accel, body.water_density_kgpm3,
+                                                   body.gravity_mps2)
+        return min(max(volume, 0.0), self.full_volume_m3)
 
     def health(self, now_s: float) -> list[Health]:
         """One Health per sensor (stale -> WARN, rejections counted) and one for the filter."""

@@ -97,6 +97,12 @@ class EkfSettings:
     wave_damping_ratio: float = _f('wave.damping_ratio', 'oscillator damping (sea bandwidth)',
                                    0.01, 2)
     wave_sigma_m: float = _f('wave.sigma_m', 'wave elevation sigma, ~ H1/3 / 4', 0, 2)
+    heave_natural_hz: float = _f('heave.natural_frequency_hz',
+                                 'heave natural frequency afloat (vehicle.md 5: 0.5731)', 0.01, 10)
+    gps_bias_sigma_m: float = _f('gps_bias.sigma_m', 'slowly drifting DGPS position error '
+                                 'sigma (0: no bias states, message covariance used)', 0, 100)
+    gps_bias_tau_s: float = _f('gps_bias.tau_s', 'correlation time of the DGPS error', 0.01,
+                               1e5)
     # beach slope from pitch/roll
     slope_time_constant_s: float = _f('slope.time_constant_s', 'low-pass of the pitch slope',
                                       0.01, 100)

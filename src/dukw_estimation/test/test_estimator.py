@@ -95,7 +95,7 @@ def test_tracks_a_circle_and_learns_the_gyro_bias():
     assert math.remainder(odom.yaw_rad - drive.yaw, 2 * math.pi) == pytest.approx(0, abs=0.02)
     assert (odom.surge_mps, odom.yaw_rate_rps) == pytest.approx((1.0, 0.2), abs=0.05)
     assert est.ekf.x[Idx.BIAS] == pytest.approx(0.01, abs=0.002)
-    assert odom.pose_cov[0, 0] < 0.01
+    assert odom.pose_cov[0, 0] < 0.1          # from 10 m sigma; the DGPS drift stays in it
 
 
 def test_slip_per_track_from_the_ground_speed_at_that_track():
