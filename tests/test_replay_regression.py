@@ -67,7 +67,9 @@ def test_replay_reproduces_the_recorded_outputs(name):
         assert devs, f'{core}: nothing compared'
         assert all(d.compared >= 5 for d in devs.values()), core
     bad = result.exceeding(TOLERANCES, CONTINUOUS_TOLERANCE)
-    assert not bad, f'{name}: replayed outputs moved:\n' + '\n'.join(d.describe() for d in bad)
+    assert not bad, (f'{name}: replayed outputs moved:\n' + '\n'.join(d.describe() for d in bad)
+                     + '\nIf that change is on purpose: bash scripts/make_golden.sh, commit '
+                     'tests/golden/ with it.')
 
 
 def test_a_changed_controller_gain_is_caught_and_named(tmp_path):
@@ -114,7 +116,7 @@ def test_mode_manager_node_through_real_topics_makes_the_recorded_changes():
             player = NodeProcess('dukw_bringup', 'play', [
                 str(bag), '--clock', '--rate', '2',
                 '--topics', 'water/contact', 'depth', 'traction', 'tracks/status',
-                '--wait-for', 'water/contact', 'depth', 'traction', 'tracks/status',
+                '--wait-for', 'water/contact', 'depth', 'traction', 'tracks/status', 'clock',
                 '--wait-timeout', '30'])
             spin_until(executor, lambda: not player.alive() and seen
                        and seen[-1][0] > end_s - 1.0, 90)

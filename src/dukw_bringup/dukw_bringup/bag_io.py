@@ -13,7 +13,7 @@ import functools
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterable, Iterator, Sequence
+from typing import Any, Iterable, Iterator, NamedTuple, Sequence
 
 from rosbags.interfaces import (Connection, Qos, QosDurability, QosHistory, QosLiveliness,
                                 QosReliability, QosTime)
@@ -98,9 +98,11 @@ def default_qos(topic: str) -> Qos:
     return make_qos(transient_local=topic_key(topic) in LATCHED_TOPICS)
 
 
-@dataclass(frozen=True)
-class BagMessage:
-    """One serialized message of a bag: CDR bytes, receive time, topic and type."""
+class BagMessage(NamedTuple):
+    """One serialized message of a bag: CDR bytes, receive time, topic and type.
+
+    A NamedTuple, not a dataclass: it is made once per message while streaming.
+    """
 
     topic: str
     msgtype: str
@@ -213,7 +215,8 @@ def read_messages(path: str | Path, topics: Iterable[str] | None = None
         if wanted is not None and not conns:
             return
         for conn, timestamp, raw in reader.messages(connections=conns):
-            yield BagMessage(conn.topic, conn.msgtype, timestamp, bytes(raw))
+            yield BagMessage(conn.topic, conn.msgtype, timestamp,
+                             raw if type(raw) is bytes else bytes(raw))
     finally:
         reader.close()
 

@@ -114,16 +114,19 @@ class Player:
             self.clock_publisher = node.create_publisher(Clock, '/clock', publisher_qos(False))
 
     def matched(self) -> dict[str, int]:
-        """Matched subscriptions per bag topic, now."""
-        return {topic: pub.get_subscription_count() for topic, pub in self.publishers.items()}
+        """Matched subscriptions per played topic (and /clock if published), now."""
+        pubs = dict(self.publishers)
+        if self.clock_publisher is not None:
+            pubs['/clock'] = self.clock_publisher
+        return {topic: pub.get_subscription_count() for topic, pub in pubs.items()}
 
     def wait_for_subscribers(self, total: int = 0, topics: Sequence[str] = (),
                              timeout_s: float = 10.0,
                              stop: threading.Event | None = None) -> bool:
         """Wait until ``total`` subscriptions over all topics have matched and each of
-        ``topics`` has at least one; return False on timeout (or stop)."""
+        ``topics`` (bag topics or /clock) has at least one; False on timeout (or stop)."""
         keys = {topic_key(t) for t in topics}
-        unknown = keys - {topic_key(t) for t in self.publishers}
+        unknown = keys - {topic_key(t) for t in self.matched()}
         if unknown:
             raise BagError(f'cannot wait for {sorted(unknown)}: not played from this bag')
 

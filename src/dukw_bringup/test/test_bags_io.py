@@ -104,3 +104,25 @@ def test_missing_message_definitions_are_named(tmp_path, monkeypatch):
         monkeypatch.delenv(bag_io.MSG_DIR_ENV)
         bag_io.typestore.cache_clear()
     assert Path(bag_io.dukw_msg_dir(), 'Traction.msg').is_file()
+
+
+def test_mcap_carries_what_foxglove_and_ros2_bag_need(tmp_path):
+    # An independent reader (the mcap library): ros2 profile, cdr channels, and schemas
+    # with the full ros2msg definition, nested types included.
+    from mcap.reader import make_reader
+    store = bag_io.typestore()
+    with BagWriter(tmp_path / 'bag', compress=True) as writer:
+        writer.write_message('/traction', 'dukw_msgs/msg/Traction', 1, _traction(store, 1, 0.5))
+    with open(tmp_path / 'bag' / 'bag.mcap', 'rb') as handle:
+        reader = make_reader(handle)
+        assert reader.get_header().profile == 'ros2'
+        summary = reader.get_summary()
+        (channel,) = summary.channels.values()
+        schema = summary.schemas[channel.schema_id]
+        assert (channel.topic, channel.message_encoding) == ('/traction', 'cdr')
+        assert (schema.name, schema.encoding) == ('dukw_msgs/msg/Traction', 'ros2msg')
+        text = schema.data.decode()
+        assert 'float64 weight_on_tracks_fraction' in text and 'MSG: std_msgs/Header' in text
+        (message,) = [m for _, _, m in reader.iter_messages()]
+    assert bag_io.typestore().deserialize_cdr(message.data, 'dukw_msgs/msg/Traction'
+                                              ).port_slip == 0.5

@@ -100,3 +100,25 @@ def test_cli_streams_and_refuses_unknown_cores(tmp_path, capsys):
     assert main([str(bag), '--cores', 'no_such_core']) == 2
     assert 'no adapter' in capsys.readouterr().err
     assert main([str(tmp_path / 'missing')]) == 2
+
+
+class ReactingCore(SumCore):
+    """Reacts at once (outside its timer) to a negative input, like the controller does
+    to a lost authority."""
+
+    name = 'react'
+
+    def feed(self, topic, t_s, msg):
+        super().feed(topic, t_s, msg)
+        return {'total': -1.0, 'ticks': float(len(self.ticks))} if msg.port_pct < 0 else None
+
+
+def test_an_immediate_reaction_is_the_latest_output(tmp_path):
+    store = bag_io.typestore()
+    with bag_io.BagWriter(tmp_path / 'bag') as writer:
+        writer.write_message('/out', 'dukw_msgs/msg/DiffCommand', 100 * MS, _cmd(store, 0.0, 1.0))
+        writer.write_message('/in', 'dukw_msgs/msg/DiffCommand', 150 * MS, _cmd(store, -5.0))
+        writer.write_message('/out', 'dukw_msgs/msg/DiffCommand', 160 * MS, _cmd(store, -1.0, 1.0))
+    result = replay(tmp_path / 'bag', [ReactingCore()])
+    assert result.exceeding({}, 0.0) == []
+    assert [row['t_s'] for row in result.rows['react']] == pytest.approx([0.1, 0.15])
