@@ -2,8 +2,13 @@
 
 State: planar rigid body (x, y, yaw; surge, sway, yaw rate) plus heave, roll and
 pitch of the centre of gravity, the two track drives' speed loops and whether the
-tracks touch the ground. One fixed step of ``dt_s`` (semi-implicit Euler; the stiff
-ground forces are treated implicitly through their derivatives).
+tracks touch the ground. One fixed step of ``dt_s`` (semi-implicit Euler). The soil
+forces are stiff (on firm sand the Wong force goes from nothing to full strength
+within a few per cent of slip), so surge and yaw rate are solved implicitly with them
+(Newton passes, motor limits as caps); where that does not converge or a slip would
+change sign within the step (starting, stopping on firm sand) the tracks grip: the
+step moves the ground under the tracks at the tracks' speeds, with forces capped by
+the soil's strength and the motors.
 
 Vertical motion: on the ground the vehicle follows the beach (its tracks carry the
 effective weight W_e = (Delta - rho g V) cos theta); when the buoyancy of the hull
@@ -24,7 +29,7 @@ from dukw_common.vehicle import SoilParams, Vehicle
 from dukw_estimation import traction
 
 from dukw_sim.hull import HullGeometry, Seakeeping
-from dukw_sim.land import track_step
+from dukw_sim.land import TrackContact, linearise, motor_limited_speed
 from dukw_sim.params import SimParams, apply_overrides
 from dukw_sim.truth import Medium, Truth
 from dukw_sim.world import (Beach, WaveModel, World, irregular_waves, no_waves,
@@ -37,6 +42,18 @@ _FRICTION_EPS_MPS = 0.02       # of drivetrain friction
 _BREAKAWAY_MPS = 0.05          # below this track speed the breakaway friction applies
 _LATERAL_POINTS = 5            # points along each track for the lateral resistance
 _LAND_FRACTION = 0.02          # submerged share of the afloat volume below which: LAND
+_NEWTON_PASSES = 3             # implicit track-soil solve
+_NEWTON_TOL_MPS = 2e-4
+
+
+@dataclass(frozen=True)
+class TrackState:
+    """Both tracks after a step (port, starboard): speed, soil force, motor force, slip."""
+
+    track_speed_mps: list
+    soil_force_n: list
+    motor_force_n: list
+    slip: list
 
 
 @dataclass(frozen=True)
@@ -300,7 +317,9 @@ class SimCore:
         if targets[0] != 0.0:
             targets[0] -= math.copysign(min(abs(targets[0]), self._port_droop_mps), targets[0])
         alpha = min(dt / land.speed_loop_time_constant_s, 1.0)
-        self.ref = [self.ref[i] + (targets[i] - self.ref[i]) * alpha for i in range(2)]
+        max_dv = land.speed_loop_accel_mps2 * dt
+        self.ref = [self.ref[i] + max(-max_dv, min(max_dv, (targets[i] - self.ref[i]) * alpha))
+                    for i in range(2)]
         ground = (u0 - r0 * self._half_sep, u0 + r0 * self._half_sep)
         track_imm = min(max(float(depths.mean()) / self.seakeeping.equilibrium_depth_m, 0.0), 1.0)
         others = []
@@ -317,19 +336,16 @@ class SimCore:
             paddle.append(pad)
             others.append(fric + pad)
         soil = self._dry_soil if self.x < p.world.wet_sand_start_x_m else self._wet_soil
-        tracks = track_step(tuple(self.ref), ground, tuple(others), self._max_motor_n,
-                            w_eff / 2.0, soil, self._track_area, self._track_len)
-        self.track_speed = tracks.track_speed_mps
-        fp, fs = tracks.soil_force_n
+        contact = TrackContact(w_eff / 2.0, soil, self._track_area, self._track_len) \
+            if w_eff > 0.0 else None
+        lin = linearise(contact, tuple(self.ref), ground)
 
-        # --- forces in body axes (X forward, Y left, N yaw) and their derivatives
-        X = fp + fs + paddle[0] + paddle[1]
+        # --- forces in body axes (X forward, Y left, N yaw) and their derivatives, all but
+        # the tracks' soil forces (added in the implicit solve below)
+        X = paddle[0] + paddle[1]
         Y = 0.0
-        N = (fs - fp + paddle[1] - paddle[0]) * self._half_sep
-        j_u = -(tracks.dforce_dground[0] + tracks.dforce_dground[1])
-        j_u = -abs(j_u)
-        j_v = 0.0
-        j_r = -abs(tracks.dforce_dground[0] + tracks.dforce_dground[1]) * self._half_sep ** 2
+        N = (paddle[1] - paddle[0]) * self._half_sep
+        j_u = j_v = j_r = 0.0
         if w_eff > 0.0:
             roll_n = land.rolling_resistance_coeff * w_eff / 2.0
             for i, sign in ((0, -1.0), (1, 1.0)):
@@ -389,10 +405,43 @@ class SimCore:
         m_x = self._mass * (1.0 + wat.surge_added_mass_ratio * frac)
         m_y = self._mass * (1.0 + wat.sway_added_mass_ratio * frac)
         i_z = wat.yaw_inertia_kg_m2 * (1.0 + wat.yaw_added_inertia_ratio * frac)
-        du = dt * (X + m_y * v0 * r0) / (m_x - dt * j_u)
         dv = dt * (Y - m_x * u0 * r0) / (m_y - dt * j_v)
-        dr = dt * N / (i_z - dt * j_r)
+        # implicit in the soil forces: Newton passes, each linearising the soil forces at the
+        # previous pass's ground speeds; a track whose motor cannot give what the soil would
+        # take is held at the motor's limit (its derivative drops out)
+        base = (X + m_y * v0 * r0, N, m_x, i_z, j_u, j_r)
+        half = self._half_sep
+        g_lin = ground
+        converged = contact is None
+        for _ in range(_NEWTON_PASSES):
+            du, dr, new, limited = self._solve_tracks(base, lin, g_lin, ground, others)
+            if contact is None or all(limited):
+                converged = True
+                break
+            g_next = (u0 + du - (r0 + dr) * half, u0 + du + (r0 + dr) * half)
+            if max(abs(g_next[0] - g_lin[0]), abs(g_next[1] - g_lin[1])) < _NEWTON_TOL_MPS:
+                converged = True
+                break
+            g_lin = g_next
+            lin = linearise(contact, tuple(self.ref), g_lin)
+        if contact is not None and any(
+                (self.ref[i] - ground[i]) * (self.ref[i] - ground[i] - du
+                                             + (1.0, -1.0)[i] * dr * half) < 0.0
+                for i in range(2)):
+            converged = False          # a track's slip would change sign within the step
+        if not converged:
+            # the soil force is nearly a step at these slips (firm sand, low speed): the
+            # tracks grip; solve the step with the ground under the tracks moving at the
+            # tracks' speeds, within what the soil and the motors can give
+            du, dr, new, limited = self._grip_step(base, contact, u0, r0, others)
         self.u, self.v, self.r = u0 + du, v0 + dv, r0 + dr
+        half = self._half_sep
+        ground_new = (self.u - self.r * half, self.u + self.r * half)
+        speeds = [motor_limited_speed(contact, self.ref[i], ground_new[i], new[i])
+                  if limited[i] else self.ref[i] for i in range(2)]
+        self.track_speed = speeds
+        slips = traction.slip(np.array(speeds), np.array(ground_new)).tolist()
+        tracks = TrackState(speeds, new, [new[i] + others[i] for i in range(2)], slips)
         self.yaw = (self.yaw + dt * self.r + math.pi) % (2.0 * math.pi) - math.pi
         self.x += dt * (c * self.u - s * self.v)
         self.y += dt * (s * self.u + c * self.v)
@@ -424,6 +473,64 @@ class SimCore:
                  (self.heave_vel - hv0) / dt)
         self.truth = self._compute_truth(act, (tracks, thrust, w_eff, fwx, fwy, accel))
         return self.truth
+
+    def _solve_tracks(self, base: tuple, lin, g_lin: tuple, g_old: tuple, others: list):
+        """Implicit surge and yaw-rate change with the soil forces linearised at ``g_lin``.
+
+        Returns (du, dr, soil force per track, which tracks the motor limits).
+        """
+        x0, n0, m_x, i_z, j_u, j_r = base
+        dt, half = self.dt_s, self._half_sep
+        deriv = list(lin.dforce_dground)
+        force = [lin.force_n[i] + deriv[i] * (g_old[i] - g_lin[i]) for i in range(2)]
+        limited = [False, False]
+        for _ in range(3):
+            # [m_x - dt (j_u + Dp + Ds), -dt p (Ds - Dp); -dt p (Ds - Dp), i_z - dt (j_r + p^2
+            # (Dp + Ds))] [du, dr] = dt [X + Fp + Fs, N + p (Fs - Fp)]
+            cross = -dt * half * (deriv[1] - deriv[0])
+            a11 = m_x - dt * (j_u + deriv[0] + deriv[1])
+            a22 = i_z - dt * (j_r + (deriv[0] + deriv[1]) * half * half)
+            b1 = dt * (x0 + force[0] + force[1])
+            b2 = dt * (n0 + (force[1] - force[0]) * half)
+            det = a11 * a22 - cross * cross
+            du = (b1 * a22 - cross * b2) / det
+            dr = (a11 * b2 - cross * b1) / det
+            new = [force[0] + deriv[0] * (du - dr * half), force[1] + deriv[1] * (du + dr * half)]
+            again = False
+            for i in range(2):
+                need = new[i] + others[i]
+                if not limited[i] and abs(need) > self._max_motor_n:
+                    limited[i] = True
+                    force[i] = math.copysign(self._max_motor_n, need) - others[i]
+                    deriv[i] = 0.0
+                    again = True
+            if not again:
+                break
+        return du, dr, new, limited
+
+    def _grip_step(self, base: tuple, contact, u0: float, r0: float, others: list):
+        """Surge and yaw-rate change with the tracks gripping (no slip), forces capped by
+        the soil's strength and the motors' limit. Returns (du, dr, forces, limited)."""
+        x0, n0, m_x, i_z, j_u, j_r = base
+        dt, half = self.dt_s, self._half_sep
+        du = 0.5 * (self.ref[0] + self.ref[1]) - u0
+        dr = (self.ref[1] - self.ref[0]) / (2.0 * half) - r0
+        total = m_x * du / dt - x0 - j_u * du
+        turn = (i_z * dr / dt - n0 - j_r * dr) / half
+        want = [0.5 * (total - turn), 0.5 * (total + turn)]
+        strength = float(traction.max_traction_n(contact.weight_per_track_n, contact.soil,
+                                                 contact.area_m2))
+        limited = [False, False]
+        force = []
+        for i in range(2):
+            lo = max(-strength, -self._max_motor_n - others[i])
+            hi = min(strength, self._max_motor_n - others[i])
+            limited[i] = not lo <= want[i] <= hi
+            force.append(min(max(want[i], lo), hi))
+        if any(limited):
+            du = dt * (x0 + force[0] + force[1]) / (m_x - dt * j_u)
+            dr = dt * (n0 + (force[1] - force[0]) * half) / (i_z - dt * j_r)
+        return du, dr, force, limited
 
     def _thrust(self, pct: float) -> float:
         """Propeller thrust for a command, N (reverse weaker, vehicle.md section 1)."""

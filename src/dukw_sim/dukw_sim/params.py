@@ -83,6 +83,7 @@ class LandParams:
 
     max_current_a: float
     speed_loop_time_constant_s: float
+    speed_loop_accel_mps2: float
     speed_loop_stiffness_n_per_mps: float
     drivetrain_friction_n: float
     port_extra_friction_n: float
@@ -93,7 +94,7 @@ class LandParams:
     min_shear_modulus_m: float
 
     def __post_init__(self) -> None:
-        _positive(self, 'max_current_a', 'speed_loop_time_constant_s',
+        _positive(self, 'max_current_a', 'speed_loop_time_constant_s', 'speed_loop_accel_mps2',
                   'speed_loop_stiffness_n_per_mps', 'lateral_slip_speed_mps')
 
 

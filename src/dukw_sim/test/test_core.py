@@ -180,3 +180,21 @@ def test_waves_lift_the_hull_off_the_sand_intermittently():
     assert np.count_nonzero(np.diff(contact)) >= 4            # touching, lifting, touching...
     assert truths[0].medium == Medium.LAND and truths[-1].medium == Medium.WATER
     assert min(t.effective_weight_n for t in truths) == 0.0
+
+
+def test_reverse_on_sand_backs_up_at_the_commanded_speed():
+    sim = SimCore.from_config()
+    sim.reset(x_m=-40.0)
+    truth = run(sim, Actuation(-52, -48), 400)          # the port bias, backwards
+    assert truth.surge_mps == pytest.approx(-0.96, abs=0.05)
+    assert truth.port_current_a < 0.0 and truth.stbd_current_a < 0.0   # driving backwards
+    assert abs(truth.yaw_rate_rps) < 0.02
+
+
+def test_track_forces_are_smooth_from_rest():
+    """Firm sand grips: from rest the force is what accelerates the vehicle, no chatter."""
+    sim = SimCore.from_config()
+    sim.reset(x_m=-30.0)
+    forces = np.array([sim.step(Actuation(64, 60)).stbd_force_n for _ in range(300)])
+    assert forces.min() > 0.0
+    assert np.max(np.abs(np.diff(forces[1:30]))) < 5.0
