@@ -152,3 +152,14 @@ def test_one_off_builders_return_fresh_messages():
     assert (a.depth_m, b.depth_m) == (1.5, 2.5) and a.header.frame_id == 'base_link'
     state = AuthorityState(Holder.COMPUTER, Reason.RC_SWITCH, True, False, 'computer')
     assert sm.authority(state, 1.0).holder == Authority.HOLDER_COMPUTER
+
+
+def test_sim_node_declares_every_key_of_its_config_block_own_ones_with_ranges():
+    from dukw_common.config import node_params
+    from dukw_sim.sim_params import sim_node_specs
+    specs = {s.name: s for s in sim_node_specs()}
+    assert set(node_params('sim_node')) <= set(specs)
+    for name in ('real_time_factor', 'rates.imu_hz', 'noise.gyro_std_rps', 'max_lag_s'):
+        assert specs[name].min is not None, name
+    assert specs['real_time_factor'].min == 0.0
+    assert all(s.description for s in specs.values())
