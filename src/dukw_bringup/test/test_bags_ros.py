@@ -124,12 +124,12 @@ def test_play_delivers_every_message_in_order_to_another_process(tmp_path):
                                  lambda m: received.append(m.header.stamp.sec), keep_all)
         node.create_subscription(DriveMode, 'drive_mode', lambda m: modes.append(m.reason),
                                  STATE_QOS)
-        node.create_subscription(Clock, '/clock', lambda m: clocks.append(m.clock.sec),
-                                 COMMAND_QOS)
+        node.create_subscription(Clock, '/clock', lambda m: clocks.append(
+            m.clock.sec + m.clock.nanosec * 1e-9), keep_all)
         # 200 messages 10 ms apart = 2 s of bag time, at rate 4: about 0.5 s
         player = NodeProcess('dukw_bringup', 'play', [
-            str(tmp_path / 'bag'), '--rate', '4', '--clock', '--wait-for-subscribers', '2',
-            '--wait-for', 'tracks/cmd', 'drive_mode', '--wait-timeout', '20'])
+            str(tmp_path / 'bag'), '--rate', '4', '--clock', '--wait-for-subscribers', '3',
+            '--wait-for', 'tracks/cmd', 'drive_mode', 'clock', '--wait-timeout', '20'])
         try:
             spin_until(executor, lambda: len(received) == n and modes, 60)
         finally:
@@ -138,6 +138,9 @@ def test_play_delivers_every_message_in_order_to_another_process(tmp_path):
     assert f'published {n + 1} messages' in player.stdout
     assert received == list(range(n))
     assert modes == ['from the bag']
+    # /clock carries the bag time (2 s of it at 100 Hz), never going back
+    assert len(clocks) > 100 and clocks == sorted(clocks)
+    assert clocks[-1] == pytest.approx(1.99, abs=0.011)
 
 
 def test_play_refuses_a_missing_bag_and_unknown_topics(tmp_path):
