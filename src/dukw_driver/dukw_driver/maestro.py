@@ -226,7 +226,13 @@ class ServoSwitch:
         self.last_reading: RcReading | None = None
         self._last_reading_s = -math.inf
         self._select_high = self._link_high = False
-        self.device_errors: tuple[str, ...] = ()
+        self.device_errors: tuple[str, ...] = ()     # in the last reading
+        self._errors_seen: set[str] = set()
+
+    def take_device_errors(self) -> list[str]:
+        """Maestro error bits seen since the last call (reading the register clears it)."""
+        seen, self._errors_seen = sorted(self._errors_seen), set()
+        return seen
 
     def _queries(self) -> tuple[bytes, list[str]]:
         cfg = self.config
@@ -245,6 +251,7 @@ class ServoSwitch:
         span = cfg.stick_us_at_5v - cfg.stick_us_at_0v
         sticks = tuple(cfg.stick_us_at_0v + raw / MAX_INPUT_RAW * span for raw in values[2:-1])
         self.device_errors = tuple(decode_errors(values[-1]))
+        self._errors_seen.update(self.device_errors)
         selected = self._select_high == cfg.select_rc_when_high
         link_ok = self._link_high == cfg.link_ok_when_high
         if not link_ok:  # the receiver's outputs mean nothing now: report "no pulse"

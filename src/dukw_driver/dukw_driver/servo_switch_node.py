@@ -116,12 +116,12 @@ class ServoSwitchNode(Node):
         self.health.parse_errors = self.switch.parser.parse_errors
         health = self.health.health(self.link, now)
         state = self.switch.gate.state
+        device_errors = self.switch.take_device_errors()
         health.values.update(reply_timeouts=self.switch.parser.timeouts,
                              commands_refused=self.rejected, holder=state.holder.name,
-                             reason=state.reason.name,
-                             device_errors=','.join(self.switch.device_errors))
-        if self.switch.device_errors:
-            health.worsen(Level.WARN, 'Maestro errors: ' + ', '.join(self.switch.device_errors))
+                             reason=state.reason.name, device_errors=','.join(device_errors))
+        if device_errors:
+            health.worsen(Level.WARN, 'Maestro errors: ' + ', '.join(device_errors))
         self.diag_pub.publish(diagnostic_array(self, [health]))
 
     def on_shutdown(self) -> None:

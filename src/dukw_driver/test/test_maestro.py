@@ -151,6 +151,8 @@ def test_maestro_errors_are_reported_by_name():
     assert switch.device_errors == reading.errors
     reading = switch.feed(maestro.feed(switch.cycle(0.02)), 0.03)
     assert reading.errors == ()  # reading the register cleared it
+    assert switch.take_device_errors() == ['serial_signal', 'serial_timeout']  # kept for /diag
+    assert switch.take_device_errors() == []
 
 
 def test_parser_counts_unsolicited_short_and_out_of_range_replies():

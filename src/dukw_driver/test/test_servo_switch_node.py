@@ -160,3 +160,12 @@ def test_bad_port_parameter_is_refused_with_its_name():
     code = proc.stop()
     assert code == 2
     assert "'baud'" in proc.stderr and 'Traceback' not in proc.stderr
+
+
+def test_maestro_error_register_is_a_warning_on_diagnostics(graph, maestro):
+    assert graph.spin_until(lambda: graph.holder_is(Authority.HOLDER_COMPUTER))
+    with maestro.lock:
+        maestro.errors = 1 << 5  # serial timeout: the Maestro went to its home positions
+    assert graph.spin_until(lambda: graph.level() == DiagnosticStatus.WARN
+                            and 'serial_timeout' in graph.status('maestro').message)
+    assert graph.value('maestro', 'device_errors') == 'serial_timeout'
