@@ -267,7 +267,6 @@ class SimCore:
         c, s = math.cos(self.yaw), math.sin(self.yaw)
 
         # --- water at the strips and sample points
-        n = self._n_stations
         gz, gpitch, groll, slope = self._ground_pose()
         if self.in_contact:
             self.z_cg, self.pitch, self.roll = gz + self._kg, gpitch, groll

@@ -7,11 +7,13 @@ water surface (``dukw_estimation.buoyancy.segment_area_m2``), so the hull's volu
 almost wholly immersed when afloat (0.288 of 0.313 m^3): 4 cm above the float line
 their waterplane vanishes and a 28 cm wave would leave heave and pitch without
 stiffness. Above the float line each hull therefore continues wall-sided (the SWATH
-struts), with the waterplane area of vehicle.md section 1 (A_W = 0.89 m^2). The same strips give the heave force and the
-roll and pitch moments, and the Froude-Krylov surge force from the water's particle
-acceleration. The rigid-body inertias are chosen from the linearised hydrostatic
-stiffness at the calm-water equilibrium so that heave, roll and pitch oscillate at the
-measured natural frequencies (vehicle.md section 5).
+struts), with the waterplane area of vehicle.md section 1 (A_W = 0.89 m^2). The
+same strips give the heave force and the roll and pitch moments, and the Froude-Krylov
+surge force from the water's particle acceleration. The rigid-body inertias (with added
+mass) are chosen from the hydrostatic stiffness at the float line so that heave, roll
+and pitch oscillate at the measured natural frequencies (vehicle.md section 5); the
+roll stiffness of two hulls 0.81 m apart implies GM ~0.5 m, not the paper's 0.14 m,
+so the roll inertia absorbs the difference.
 """
 from __future__ import annotations
 
@@ -106,7 +108,7 @@ class Seakeeping:
     @classmethod
     def calibrate(cls, hull: HullGeometry, vehicle: Vehicle,
                   params: SeakeepingParams) -> 'Seakeeping':
-        """Inertias from the strip stiffness at the calm equilibrium and the measured frequencies."""
+        """Inertias from the strip stiffness at the float line and the measured frequencies."""
         body = vehicle.body
         rho_g = body.water_density_kgpm3 * body.gravity_mps2
         d0 = hull.float_depth_m

@@ -325,7 +325,7 @@ def build_parser() -> argparse.ArgumentParser:
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument('--csv', metavar='PATH', help='write one row per 0.01 s step here')
     common.add_argument('--seed', type=int, default=0, help='random seed (waves)')
-    common.add_argument('--config', metavar='PATH', help='parameter file (default: the stack\'s)')
+    common.add_argument('--config', metavar='PATH', help="parameter file (default: the stack's)")
     sub = parser.add_subparsers(dest='maneuver', required=True)
     p = sub.add_parser('circle', parents=[common], help='constant commands, fit the circle')
     p.add_argument('--medium', choices=['land', 'water'], required=True)
