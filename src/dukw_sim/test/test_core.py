@@ -198,3 +198,19 @@ def test_track_forces_are_smooth_from_rest():
     forces = np.array([sim.step(Actuation(64, 60)).stbd_force_n for _ in range(300)])
     assert forces.min() > 0.0
     assert np.max(np.abs(np.diff(forces[1:30]))) < 5.0
+
+
+@pytest.mark.parametrize('start', ['sand', 'surf', 'afloat'])
+def test_random_commands_keep_every_field_finite(start):
+    rng = np.random.default_rng(11)
+    sim = SimCore.from_config(overrides=WAVES, seed=4)
+    sim.reset(start)
+    act = Actuation()
+    for k in range(1500):
+        if k % 50 == 0:
+            act = Actuation(*rng.uniform(-100.0, 100.0, 4))
+        truth = sim.step(act)
+        for f in fields(Truth):
+            assert math.isfinite(float(getattr(truth, f.name))), (k, f.name)
+    assert abs(truth.roll_rad) < 0.5 and abs(truth.pitch_rad) < 0.5
+    assert abs(truth.surge_mps) < 3.0
