@@ -23,7 +23,7 @@ TOLERANCES = {'mode': 0.0, 'automatic': 0.0, 'tracks_idle': 0.0}
 CORES = ('ekf', 'mode_manager', 'drive_controller')
 #: what each golden run must show on drive_mode (guards a regeneration gone wrong)
 EXPECTED_MODES = {'land_circle': ['LAND'], 'land_to_sea': ['LAND', 'TRANSITION', 'WATER'],
-                  'sea_to_land': ['TRANSITION', 'LAND']}
+                  'sea_to_land': ['WATER', 'TRANSITION', 'LAND']}
 MODE_NAMES = {0: 'LAND', 1: 'TRANSITION', 2: 'WATER', 3: 'SAFE_STOP'}
 
 
