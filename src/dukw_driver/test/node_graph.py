@@ -21,7 +21,8 @@ class NodeGraph:
         self.probe.create_subscription(msg_type, topic, messages.append, qos)
         return messages
 
-    def spin_until(self, predicate, timeout_s=5.0):
+    def spin_until(self, predicate, timeout_s=10.0):
+        """Spin until ``predicate()``; generous default for a loaded machine."""
         return spin_until(self.executor, predicate, timeout_s)
 
     def status(self, device):
