@@ -151,31 +151,15 @@ def grounded_volume_m3(waterline_distance_m: float, slope_rad: float, hull_clear
     return 2.0 * one
 
 
-def floating_depth_m(displaced_volume_m3: float, radius_m: float, length_m: float) -> float:
-    """Water depth over the bottoms of two level hulls that displace ``displaced_volume_m3``."""
-    target = displaced_volume_m3 / (2.0 * length_m)
-    if not 0.0 <= target < math.pi * radius_m ** 2:
-        raise ValueError('two hulls of this size cannot displace that volume')
-    lo, hi = 0.0, 2.0 * radius_m
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if float(segment_area_m2(mid, radius_m)) < target else (lo, mid)
-    return 0.5 * (lo + hi)
 
-
-def heave_mass_kg(displaced_volume_m3: float, radius_m: float, length_m: float,
-                  water_density_kgpm3: float, gravity_mps2: float,
+def heave_mass_kg(waterplane_area_m2: float, water_density_kgpm3: float, gravity_mps2: float,
                   heave_natural_hz: float) -> float:
-    """Heave mass (with added mass) that makes the floating hulls heave at the measured frequency.
-
-    Stiffness rho g A_w of the two hulls' waterplane at the floating depth, divided by
-    (2 pi f)^2 (vehicle.md section 5).
-    """
-    r = radius_m
-    d = floating_depth_m(displaced_volume_m3, r, length_m)
-    waterplane_m2 = 2.0 * length_m * 2.0 * math.sqrt(max(d * (2.0 * r - d), 0.0))
-    return water_density_kgpm3 * gravity_mps2 * waterplane_m2 / (2 * math.pi * heave_natural_hz) ** 2
-
+    """Heave mass (with added mass) that makes the floating vehicle heave at the measured
+    natural frequency: the waterplane stiffness rho g A_W over (2 pi f)^2 (vehicle.md 1, 5)."""
+    if heave_natural_hz <= 0.0 or waterplane_area_m2 <= 0.0:
+        raise ValueError('heave_mass_kg needs a positive waterplane area and frequency')
+    return water_density_kgpm3 * gravity_mps2 * waterplane_area_m2 / (
+        2.0 * math.pi * heave_natural_hz) ** 2
 
 def afloat_dynamic_volume_m3(displacement_n: float, heave_mass_kg_: float,
                              vertical_accel_mps2: float, water_density_kgpm3: float,

@@ -42,6 +42,8 @@ class Idx(IntEnum):
 N_STATES = len(Idx)
 #: The states the water-contact and depth measurements may correct.
 SURFACE_STATES = np.array([1.0 if i in (Idx.S, Idx.ETA, Idx.ETA_RATE) else 0.0 for i in Idx])
+#: A sounding afloat mixes the wave with the vehicle's heave: it may correct s only.
+WATERLINE_STATE = np.array([1.0 if i == Idx.S else 0.0 for i in Idx])
 
 
 class Outcome(Enum):

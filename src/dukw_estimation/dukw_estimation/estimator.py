@@ -17,8 +17,8 @@ from dukw_common.diagnostics import Health, Level, RateCounter
 from dukw_common.geometry import local_enu_from_geodetic, wrap_angle
 from dukw_common.vehicle import SoilParams, Vehicle
 from dukw_estimation import buoyancy, traction
-from dukw_estimation.ekf import (N_STATES, SURFACE_STATES, Idx, MotionEkf, Outcome,
-                                 ProcessNoise)
+from dukw_estimation.ekf import (N_STATES, SURFACE_STATES, WATERLINE_STATE, Idx, MotionEkf,
+                                 Outcome, ProcessNoise)
 from dukw_estimation.force_filter import ForceSmoother
 from dukw_estimation.samples import (DepthReading, DriveStatus, GpsFix, GpsVelocity,
                                      ImuSample, OdometryEstimate, TractionEstimate,
@@ -28,6 +28,7 @@ from dukw_estimation.settings import SENSORS, EkfSettings
 MAX_PREDICT_STEP_S = 0.02
 GROUNDED_FRACTION = 0.5          # above this weight share the tracks drive the vehicle
 SLOPE_FRACTION = 0.9             # above this share the pitch is the beach's, not the waves'
+TOUCHDOWN_SHARE = 0.8           # afloat until the mean-surface volume drops below this share
 FRACTION_PERIOD_S = 0.1          # how often the IMU path refreshes the weight share
 
 
@@ -44,11 +45,9 @@ class Estimator:
         self.hull_bow_x_m = min(0.5 * body.hull_length_m, body.bow_x_m)
         self.hull_stern_x_m = max(-0.5 * body.hull_length_m, body.stern_x_m)
         self.track_area_m2 = body.track_width_m * body.track_contact_length_m
-        hull_length = self.hull_bow_x_m - self.hull_stern_x_m
-        self.full_volume_m3 = 2.0 * math.pi * body.hull_radius_m ** 2 * hull_length
-        self.heave_mass_kg = buoyancy.heave_mass_kg(
-            body.displaced_volume_m3, body.hull_radius_m, hull_length, body.water_density_kgpm3,
-            body.gravity_mps2, settings.heave_natural_hz)
+        self.heave_mass_kg = buoyancy.heave_mass_kg(body.waterplane_area_m2,
+                                                    body.water_density_kgpm3,
+                                                    body.gravity_mps2, settings.heave_natural_hz)
         self.counters: dict[str, dict[Outcome, int]] = {s: defaultdict(int) for s in SENSORS}
         self.rates = {s: RateCounter() for s in SENSORS}
         self.reset()
@@ -80,6 +79,8 @@ class Estimator:
         self.props: DriveStatus | None = None
         self.slope_rad = self.vehicle.site.beach_slope_rad
         self.fraction = 1.0
+        self.afloat = False
+        self.motion = 0.0                # > 1: rolling, pitching, heaving like a floating hull
         self._fraction_t_s = -math.inf
         self.force = [ForceSmoother(st.force_process_n_per_s, st.force_measurement_n)
                       for _ in range(2)]
@@ -179,6 +180,7 @@ class Estimator:
             return rejected
         dt = s.t_s - self.imu.t_s if self.imu is not None else 0.0
         self.imu = self._imu_at_base_link(s, dt)
+        self._update_motion(self.imu, dt)
         st = self.settings
         h = np.zeros(N_STATES)
         h[Idx.R] = h[Idx.BIAS] = 1.0
@@ -217,6 +219,17 @@ class Estimator:
             s, accel_x_mps2=s.accel_x_mps2 - (alpha_y + wz * wx) * h,
             accel_y_mps2=s.accel_y_mps2 + (alpha_x - wz * wy) * h,
             accel_z_mps2=s.accel_z_mps2 + (wx * wx + wy * wy) * h)
+
+    def _update_motion(self, s: ImuSample, dt: float) -> None:
+        """Low-pass of (roll/pitch rate, heave acceleration) over their thresholds, squared."""
+        st = self.settings
+        tilt = math.cos(s.roll_rad) * math.cos(s.pitch_rad)
+        heave = s.accel_z_mps2 / max(tilt, 0.5) - self.vehicle.body.gravity_mps2 \
+            if math.isfinite(s.accel_z_mps2) else 0.0
+        level = ((s.roll_rate_rps ** 2 + s.pitch_rate_rps ** 2) / st.contact_rate_rps ** 2
+                 + heave ** 2 / st.contact_accel_mps2 ** 2)
+        alpha = min(dt / st.contact_time_constant_s, 1.0) if dt > 0.0 else 1.0
+        self.motion += alpha * (level - self.motion)
 
     def _update_slope(self, s: ImuSample, dt: float) -> None:
         """Low-pass the beach slope along the seaward direction from pitch and roll."""
@@ -339,7 +352,7 @@ class Estimator:
         floor_depth = min(floor_depth, site.sea_floor_depth_m)
         predicted = x[Idx.ETA] - body.draft_m + mounts.depth_sounder_z_m + floor_depth
         out = self.ekf.update_scalar(s.depth_m, predicted, h, self.settings.depth_m ** 2,
-                                     self.settings.gate_depth, only=SURFACE_STATES)
+                                     self.settings.gate_depth, only=WATERLINE_STATE)
         return self._count('depth', out)
 
     def add_tracks(self, s: DriveStatus) -> Outcome:
@@ -406,9 +419,11 @@ class Estimator:
         args = (x[Idx.S], slope, body.hull_clearance_m, self.hull_bow_x_m, self.hull_stern_x_m)
         h2 = buoyancy.submerged_length_m(*args, x[Idx.ETA], heading_cos)
         volume = buoyancy.grounded_volume_m3(*args, body.hull_radius_m, x[Idx.ETA], heading_cos)
-        afloat = volume >= body.displaced_volume_m3
+        afloat = self.afloat = self._floating(volume)
         if afloat:
             volume = self._afloat_volume()
+        else:
+            volume = min(volume, body.displaced_volume_m3)   # on the sand: it does not float
         weight = 0.0 if afloat else traction.effective_weight_n(
             body.displacement_n, volume, slope, body.water_density_kgpm3, body.gravity_mps2)
         self.fraction = weight / (body.displacement_n * math.cos(slope))
@@ -429,6 +444,23 @@ class Estimator:
                                 predicted[1], self.force[0].force_n, self.force[1].force_n,
                                 afloat, float(x[Idx.ETA]))
 
+    def _floating(self, grounded_volume_m3: float) -> bool:
+        """Afloat or on the sand: the IMU's motion test when fresh, else the geometry.
+
+        Deep enough water (the estimated surface gives the displacement; with hysteresis: once
+        afloat, the hulls must sit clearly shallower to touch down) floats it. In the surf, the
+        IMU tells: on the sand the vehicle lies on the beach (no roll/pitch rate, no heave
+        acceleration); floating, it rolls, pitches and heaves with the waves.
+        """
+        displaced = self.vehicle.body.displaced_volume_m3
+        limit = displaced * (TOUCHDOWN_SHARE if self.afloat else 1.0)
+        if grounded_volume_m3 >= limit:
+            return True                  # deep enough to float even in calm water
+        if self.imu is not None and self.t_s is not None and self._fresh('imu', self.t_s):
+            return self.motion > 1.0 and \
+                grounded_volume_m3 >= self.settings.contact_min_volume_share * displaced
+        return False
+
     def _afloat_volume(self) -> float:
         """Floating: the displacement, plus what the heave acceleration says (IMU fresh)."""
         body = self.vehicle.body
@@ -441,7 +473,7 @@ class Estimator:
         volume = buoyancy.afloat_dynamic_volume_m3(body.displacement_n, self.heave_mass_kg,
                                                    heave_accel, body.water_density_kgpm3,
                                                    body.gravity_mps2)
-        return min(max(volume, 0.0), self.full_volume_m3)
+        return min(max(volume, 0.0), 2.0 * body.displaced_volume_m3)
 
     def health(self, now_s: float) -> list[Health]:
         """One Health per sensor (stale -> WARN, rejections counted) and one for the filter."""

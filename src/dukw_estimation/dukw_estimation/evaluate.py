@@ -193,7 +193,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                         help='run only this scenario (repeatable); default: all')
     parser.add_argument('--duration', type=float, default=30.0, help='seconds per run')
     parser.add_argument('--seed', type=int, default=0)
-    parser.add_argument('--config', help='parameter file (default: the stack\'s)')
+    parser.add_argument('--config', help="parameter file (default: the stack's)")
     args = parser.parse_args(argv)
     if not args.duration > WARM_UP_S:
         parser.error(f'--duration must be longer than the {WARM_UP_S} s warm-up')

@@ -99,6 +99,15 @@ class EkfSettings:
     wave_sigma_m: float = _f('wave.sigma_m', 'wave elevation sigma, ~ H1/3 / 4', 0, 2)
     heave_natural_hz: float = _f('heave.natural_frequency_hz',
                                  'heave natural frequency afloat (vehicle.md 5: 0.5731)', 0.01, 10)
+    contact_rate_rps: float = _f('contact.rate_threshold_rps', 'roll/pitch rate scale above '
+                                 'which the hull is taken to float (grounded: ~0)', 1e-4, 10)
+    contact_accel_mps2: float = _f('contact.accel_threshold_mps2',
+                                   'heave acceleration scale for the same test', 1e-4, 100)
+    contact_time_constant_s: float = _f('contact.time_constant_s',
+                                        'low-pass of that motion test', 1e-3, 10)
+    contact_min_volume_share: float = _f('contact.min_volume_share',
+                                         'floating needs at least this share of the '
+                                         'displacement under water (bumps on land)', 0, 1)
     gps_bias_sigma_m: float = _f('gps_bias.sigma_m', 'slowly drifting DGPS position error '
                                  'sigma (0: no bias states, message covariance used)', 0, 100)
     gps_bias_tau_s: float = _f('gps_bias.tau_s', 'correlation time of the DGPS error', 0.01,
