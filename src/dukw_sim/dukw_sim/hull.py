@@ -27,6 +27,8 @@ from dukw_estimation.buoyancy import segment_area_m2
 
 from dukw_sim.params import SeakeepingParams
 
+_SECANT_M = 0.02          # heave amplitude the linearised stiffness is taken over
+
 
 @dataclass(frozen=True)
 class HullGeometry:
@@ -112,7 +114,12 @@ class Seakeeping:
         body = vehicle.body
         rho_g = body.water_density_kgpm3 * body.gravity_mps2
         d0 = hull.float_depth_m
-        strip = rho_g * hull.strut_width_m * hull.strip_length_m   # waterplane at the float line
+        # the waterplane is the strut's above the float line, the cylinder's (widening
+        # downwards) below it: an oscillation of a few cm about the float line sees the mean
+        # of the strut and the cylinder's secant over _SECANT_M
+        cylinder = (float(segment_area_m2(d0, hull.radius_m))
+                    - float(segment_area_m2(d0 - _SECANT_M, hull.radius_m))) / _SECANT_M
+        strip = rho_g * 0.5 * (hull.strut_width_m + cylinder) * hull.strip_length_m
         k_heave = strip * hull.station_x_m.size
         k_roll = strip * float(np.sum(hull.station_y_m ** 2))
         k_pitch = strip * float(np.sum(hull.station_x_m ** 2))
