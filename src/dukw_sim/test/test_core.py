@@ -121,7 +121,8 @@ def test_floats_at_the_displacement_with_the_papers_waterplane():
     assert -afloat.z_m == pytest.approx(body.draft_m, abs=0.02)
     heave = sim.seakeeping.heave_stiffness_n_per_m
     rho_g = body.water_density_kgpm3 * body.gravity_mps2
-    assert heave == pytest.approx(rho_g * body.waterplane_area_m2)
+    # wall-sided struts of A_W above the float line, the widening cylinders below it
+    assert rho_g * body.waterplane_area_m2 < heave < 1.1 * rho_g * body.waterplane_area_m2
 
 
 def test_imu_at_rest_reads_gravity_and_the_slope():
