@@ -15,21 +15,26 @@ from dukw_driver.authority import AuthorityState, Holder, Reason
 
 
 class Pacer:
-    """Steps per timer tick for a real-time factor; the timer period it wants."""
+    """How many physics steps are due for a real-time factor; the timer period it wants.
+
+    The node runs the due steps in a tick until they are done or its wall-clock
+    budget is spent (so commands and services get their turn), and reports how many
+    it took. The debt a slow or late tick leaves is caught up later, but never more
+    than ``max_lag_s`` of it: beyond that the simulator gives up and says so.
+    """
 
     def __init__(self, real_time_factor: float, dt_s: float, steps_per_tick: int,
-                 max_steps_per_tick: int, max_lag_s: float, wall_s: float) -> None:
+                 max_lag_s: float, wall_s: float) -> None:
         if real_time_factor < 0 or not math.isfinite(real_time_factor):
             raise ValueError(f'real_time_factor must be >= 0, got {real_time_factor}')
-        if dt_s <= 0 or steps_per_tick < 1 or max_steps_per_tick < 1 or max_lag_s <= 0:
-            raise ValueError('need dt_s > 0, steps per tick >= 1 and max_lag_s > 0')
+        if dt_s <= 0 or steps_per_tick < 1 or max_lag_s <= 0:
+            raise ValueError('need dt_s > 0, steps_per_tick >= 1 and max_lag_s > 0')
         self.rtf = real_time_factor
         self.dt_s = dt_s
         self.steps_per_tick = steps_per_tick
-        self.max_steps_per_tick = max_steps_per_tick
         self.max_lag_steps = max(1, int(max_lag_s / dt_s))
         self.wall0_s = wall_s
-        self.steps = 0          # steps taken since wall0_s (as told by steps_due callers)
+        self.steps = 0          # steps taken (as reported to took())
         self.dropped_s = 0.0    # sim time given up because the simulator could not keep up
 
     @property
@@ -38,19 +43,20 @@ class Pacer:
         return 0.0 if self.rtf == 0 else self.steps_per_tick * self.dt_s / self.rtf
 
     def steps_due(self, wall_s: float) -> int:
-        """Steps to run in the tick at ``wall_s``; counts them as taken."""
+        """Steps owed at ``wall_s`` (as fast as possible: max_lag_s worth per tick)."""
         if self.rtf == 0:
-            n = self.steps_per_tick
-        else:
-            n = int((wall_s - self.wall0_s) * self.rtf / self.dt_s) - self.steps
-            if n > self.max_lag_steps:   # cannot keep up: forget the debt beyond max_lag
-                extra = n - self.max_lag_steps
-                self.wall0_s += extra * self.dt_s / self.rtf
-                self.dropped_s += extra * self.dt_s
-                n = self.max_lag_steps
-            n = max(0, min(n, self.max_steps_per_tick))
-        self.steps += n
-        return n
+            return self.max_lag_steps
+        n = int((wall_s - self.wall0_s) * self.rtf / self.dt_s) - self.steps
+        if n > self.max_lag_steps:   # cannot keep up: forget the debt beyond max_lag
+            extra = n - self.max_lag_steps
+            self.wall0_s += extra * self.dt_s / self.rtf
+            self.dropped_s += extra * self.dt_s
+            n = self.max_lag_steps
+        return max(0, n)
+
+    def took(self, steps: int) -> None:
+        """Count the steps a tick ran."""
+        self.steps += steps
 
 
 class SpeedMeter:

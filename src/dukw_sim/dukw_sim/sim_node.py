@@ -49,7 +49,7 @@ class SimNode(Node):
         wall = time.monotonic()
         self.pacer = Pacer(p['real_time_factor'], self.core.dt_s,
                            max(1, round(1.0 / (p['rate_hz'] * self.core.dt_s))),
-                           p['max_steps_per_tick'], p['max_lag_s'], wall)
+                           p['max_lag_s'], wall)
         self.meter = SpeedMeter(wall, self.truth.t_s)
         self.publish('/clock', self.msgs.clock(self.truth.t_s))
         self.create_timer(self.pacer.period_s, self.on_tick)
@@ -80,8 +80,14 @@ class SimNode(Node):
 
     def on_tick(self) -> None:
         """Step the physics as far as the wall clock times the real-time factor asks."""
-        for _ in range(self.pacer.steps_due(time.monotonic())):
+        wall = time.monotonic()
+        due, deadline, n = self.pacer.steps_due(wall), wall + self.params['tick_budget_s'], 0
+        while n < due:
             self.step()
+            n += 1
+            if time.monotonic() >= deadline:   # let commands and services in
+                break
+        self.pacer.took(n)
 
     def step(self) -> None:
         """One physics step, then every message due at the new sim time."""

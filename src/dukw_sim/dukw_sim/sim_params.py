@@ -27,8 +27,8 @@ _OWN = [
     ParamSpec('seed', 'random seed of sensor noise and sea state', min=0, max=2**31 - 1),
     ParamSpec('command_timeout_s', 'servo switch: neutral when no command came for this long '
               '(sim time), s', min=0.01, max=10.0),
-    ParamSpec('max_steps_per_tick', 'physics steps one timer tick may run to catch up with the '
-              'wall clock', min=1, max=100000),
+    ParamSpec('tick_budget_s', 'wall-clock seconds one timer tick may spend stepping before '
+              'commands and services get their turn', min=0.001, max=1.0),
     ParamSpec('max_lag_s', 'sim seconds the simulator may fall behind wall clock x '
               'real_time_factor before it stops catching up', min=0.01, max=100.0),
     ParamSpec('frames.base', 'frame_id of the vehicle (base_link)'),

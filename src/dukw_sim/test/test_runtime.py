@@ -17,33 +17,44 @@ DT = 0.01
 
 
 def pacer(rtf, **kw):
-    args = {'steps_per_tick': 1, 'max_steps_per_tick': 20, 'max_lag_s': 0.5, 'wall_s': 100.0}
+    args = {'steps_per_tick': 1, 'max_lag_s': 0.5, 'wall_s': 100.0}
     return Pacer(rtf, DT, **{**args, **kw})
+
+
+def run_ticks(p, walls, budget=None):
+    """Take every due step (or at most ``budget`` per tick, as a tick out of time does)."""
+    taken = []
+    for wall in walls:
+        n = p.steps_due(wall)
+        n = n if budget is None else min(n, budget)
+        p.took(n)
+        taken.append(n)
+    return taken
 
 
 def test_pacer_follows_the_wall_clock_times_the_factor():
     p = pacer(10.0)
     assert p.period_s == pytest.approx(0.001)
-    steps = sum(p.steps_due(100.0 + k * 0.001) for k in range(1, 1001))
+    steps = sum(run_ticks(p, [100.0 + k * 0.001 for k in range(1, 1001)]))
     assert steps == pytest.approx(1000, abs=1)      # 1 s of wall = 10 s of sim = 1000 steps
     assert p.dropped_s == 0.0
 
 
-def test_pacer_catches_up_a_late_tick_over_several_ticks_but_not_beyond_max_lag():
+def test_pacer_catches_up_over_later_ticks_but_not_beyond_max_lag():
     p = pacer(1.0)
-    assert p.steps_due(100.15) == 15                # 150 ms late: caught up at once
-    assert p.steps_due(100.45) == 20                # 30 steps owed, 20 per tick at most
-    assert p.steps_due(100.45) == 10
-    assert p.steps_due(103.0) == 20                 # 2.55 s behind: all but 0.5 s dropped
-    assert p.dropped_s == pytest.approx(2.05, abs=0.011)
-    assert sum(p.steps_due(103.0) for _ in range(5)) == 30
+    assert run_ticks(p, [100.15]) == [15]                         # 150 ms late: at once
+    assert run_ticks(p, [100.45, 100.45, 100.45], budget=20) == [20, 10, 0]
+    assert p.dropped_s == 0.0
+    assert run_ticks(p, [103.0], budget=20) == [20]               # 2.55 s behind:
+    assert p.dropped_s == pytest.approx(2.05, abs=0.011)          # all but 0.5 s dropped
+    assert sum(run_ticks(p, [103.0] * 5)) == 30
     assert p.steps_due(103.0) == 0
 
 
-def test_pacer_as_fast_as_possible_runs_fixed_batches():
+def test_pacer_as_fast_as_possible_asks_for_max_lag_per_tick():
     p = pacer(0.0, steps_per_tick=3)
     assert p.period_s == 0.0
-    assert [p.steps_due(w) for w in (100.0, 100.0, 500.0)] == [3, 3, 3]
+    assert [p.steps_due(w) for w in (100.0, 100.0, 500.0)] == [50, 50, 50]
 
 
 @pytest.mark.parametrize('rtf', [-1.0, math.nan])
@@ -159,7 +170,7 @@ def test_sim_node_declares_every_key_of_its_config_block_own_ones_with_ranges():
     from dukw_sim.sim_params import sim_node_specs
     specs = {s.name: s for s in sim_node_specs()}
     assert set(node_params('sim_node')) <= set(specs)
-    for name in ('real_time_factor', 'rates.imu_hz', 'noise.gyro_std_rps', 'max_lag_s'):
+    for name in ('real_time_factor', 'rates.imu_hz', 'noise.gyro_std_rps', 'tick_budget_s'):
         assert specs[name].min is not None, name
     assert specs['real_time_factor'].min == 0.0
     assert all(s.description for s in specs.values())
