@@ -1,8 +1,8 @@
 """sim_node: the simulator behind exactly the drivers' topics, on sim time (/clock).
 
-Spun by rclpy's EventsExecutor (measured several times faster than the default
-executor here, see benchmarks/bench_sim_node.py); DUKW_SIM_EXECUTOR=single
-selects the SingleThreadedExecutor for comparison.
+Spun by rclpy's EventsExecutor: at a paced real-time factor it costs less CPU per
+timer tick than the default executor (benchmarks/bench_sim_node.py compares them);
+DUKW_SIM_EXECUTOR=single selects the SingleThreadedExecutor.
 """
 import os
 import time
