@@ -28,6 +28,8 @@ from dukw_control.modes import Mode, ModeDecision
 #: The node's own parameters: (name, description, min, max). Defaults live in config.
 NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
     ('rate_hz', 'control and publishing rate, Hz', 1.0, 1000.0),
+    ('diagnostics_period_s', '/diagnostics period (also sent at once on a change), s',
+     0.01, 60.0),
     ('cmd_timeout_s', 'cmd_vel age at which the output is neutral, s', 0.05, 10.0),
     ('timeout_ramp_s', 'the ramp to neutral starts this long before the timeout, s', 0.01, 10.0),
     ('max_speed_mps', 'cmd_vel linear.x beyond this is rejected, m/s', 0.0, 5.0),

@@ -44,7 +44,7 @@ class DriveControllerNode(Node):
         self.props_connected = None
         self.last_reason = None
         self.create_timer(1.0 / params['rate_hz'], self.on_timer)
-        self.create_timer(1.0, self.publish_diagnostics)
+        self.create_timer(params['diagnostics_period_s'], self.publish_diagnostics)
 
     def now_s(self) -> float:
         """Node clock (sim time under use_sim_time), seconds."""

@@ -96,6 +96,9 @@ class ModeManagerNode(Node):
             health.level = Level.ERROR
         elif not decision.automatic:
             health.level = Level.WARN
+            stale = self.core.stale_inputs(now)
+            if stale:
+                health.message += f' (forced; {stale})'
         self.diag_pub.publish(diagnostic_array(self, [health]))
 
 

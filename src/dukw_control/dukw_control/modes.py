@@ -8,6 +8,8 @@ evidence held for a debounce time, entry and exit thresholds differ
 (hysteresis), and a mode is kept for a minimum dwell time, so waves washing
 over the sensors do not make it chatter. The order is always
 LAND <-> TRANSITION <-> WATER; a needed input going stale gives SAFE_STOP.
+An operator's forced mode holds regardless of the inputs (that is what forcing is
+for, e.g. with a broken water sensor); staleness then only shows in diagnostics.
 """
 from __future__ import annotations
 
@@ -204,7 +206,7 @@ class ModeManager:
     def release(self, now_s: float) -> None:
         """Return to automatic decisions, starting from the mode the evidence shows now."""
         self._forced = None
-        stale = self._stale(now_s)
+        stale = self.stale_inputs(now_s)
         if stale:
             self._enter(Mode.SAFE_STOP, now_s, f'back to automatic; {stale}')
         else:
@@ -227,7 +229,8 @@ class ModeManager:
         names = ('water/contact', 'traction', 'tracks/status', 'depth')
         return {n: now_s - self._stamps.get(n, -math.inf) for n in names}
 
-    def _stale(self, now_s: float) -> str:
+    def stale_inputs(self, now_s: float) -> str:
+        """Which needed inputs are missing or stale ("" when all are fresh)."""
         ages = self.input_ages(now_s)
         limits = {'water/contact': self.s.water_contact_timeout_s,
                   'traction': self.s.traction_timeout_s,
@@ -274,7 +277,7 @@ class ModeManager:
         return self.decision()
 
     def _decide(self, now_s: float) -> None:
-        stale = self._stale(now_s)
+        stale = self.stale_inputs(now_s)
         if stale:
             self._enter(Mode.SAFE_STOP, now_s, stale)
             return
