@@ -91,7 +91,7 @@ class ManeuverNode(Node):
 
     def on_timer(self) -> None:
         now, player = self.now_s(), self.player
-        dt, self.last_s = now - self.last_s, now
+        dt, self.last_s = min(max(now - self.last_s, 0.0), 0.1), now
         if player.state == PlayerState.WAITING and now - self.start_s > \
                 self.params['authority_wait_s']:
             player.abort('the computer never got authority')
