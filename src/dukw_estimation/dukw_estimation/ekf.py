@@ -40,6 +40,11 @@ class Idx(IntEnum):
 
 
 N_STATES = len(Idx)
+# plain ints for the hot paths (indexing numpy with IntEnum members is slower)
+_X, _Y, _YAW, _U, _V, _R = (int(Idx.X), int(Idx.Y), int(Idx.YAW), int(Idx.U), int(Idx.V),
+                            int(Idx.R))
+_S, _ETA, _ETA_RATE, _GBE, _GBN = (int(Idx.S), int(Idx.ETA), int(Idx.ETA_RATE),
+                                   int(Idx.GPS_BIAS_E), int(Idx.GPS_BIAS_N))
 #: The states the water-contact and depth measurements may correct.
 SURFACE_STATES = np.array([1.0 if i in (Idx.S, Idx.ETA, Idx.ETA_RATE) else 0.0 for i in Idx])
 #: A sounding afloat mixes the wave with the vehicle's heave: it may correct s only.
@@ -101,48 +106,48 @@ class MotionEkf:
         if dt <= 0.0:
             return
         x = self.x
-        yaw, u, v, r = x[Idx.YAW], x[Idx.U], x[Idx.V], x[Idx.R]
+        yaw, u, v, r = x[_YAW], x[_U], x[_V], x[_R]
         c, s = math.cos(yaw), math.sin(yaw)
         rel = yaw - self.seaward_yaw_rad
         cr, sr = math.cos(rel), math.sin(rel)
         inv_cos = 1.0 / math.cos(slope_rad)
         F = self._eye.copy()
-        x[Idx.X] += (u * c - v * s) * dt
-        x[Idx.Y] += (u * s + v * c) * dt
-        F[Idx.X, Idx.YAW] = (-u * s - v * c) * dt
-        F[Idx.X, Idx.U] = c * dt
-        F[Idx.X, Idx.V] = -s * dt
-        F[Idx.Y, Idx.YAW] = (u * c - v * s) * dt
-        F[Idx.Y, Idx.U] = s * dt
-        F[Idx.Y, Idx.V] = c * dt
-        x[Idx.S] += (u * cr - v * sr) * inv_cos * dt
-        F[Idx.S, Idx.YAW] = (-u * sr - v * cr) * inv_cos * dt
-        F[Idx.S, Idx.U] = cr * inv_cos * dt
-        F[Idx.S, Idx.V] = -sr * inv_cos * dt
-        x[Idx.YAW] = wrap_angle(yaw + r * dt)
-        F[Idx.YAW, Idx.R] = dt
+        x[_X] += (u * c - v * s) * dt
+        x[_Y] += (u * s + v * c) * dt
+        F[_X, _YAW] = (-u * s - v * c) * dt
+        F[_X, _U] = c * dt
+        F[_X, _V] = -s * dt
+        F[_Y, _YAW] = (u * c - v * s) * dt
+        F[_Y, _U] = s * dt
+        F[_Y, _V] = c * dt
+        x[_S] += (u * cr - v * sr) * inv_cos * dt
+        F[_S, _YAW] = (-u * sr - v * cr) * inv_cos * dt
+        F[_S, _U] = cr * inv_cos * dt
+        F[_S, _V] = -sr * inv_cos * dt
+        x[_YAW] = wrap_angle(yaw + r * dt)
+        F[_YAW, _R] = dt
         if accel_body is not None:
-            x[Idx.U] += accel_body[0] * dt
-            x[Idx.V] += accel_body[1] * dt
+            x[_U] += accel_body[0] * dt
+            x[_V] += accel_body[1] * dt
         elif drive_target is not None:
             u_t, r_t, tau = drive_target
             k = min(dt / tau, 1.0)
-            x[Idx.U] += (u_t - u) * k
-            x[Idx.V] -= v * k
-            x[Idx.R] += (r_t - r) * k
-            F[Idx.U, Idx.U] = F[Idx.V, Idx.V] = F[Idx.R, Idx.R] = 1.0 - k
+            x[_U] += (u_t - u) * k
+            x[_V] -= v * k
+            x[_R] += (r_t - r) * k
+            F[_U, _U] = F[_V, _V] = F[_R, _R] = 1.0 - k
         n = self.noise
         w, z = n.wave_omega_rps, n.wave_damping
-        eta, eta_rate = x[Idx.ETA], x[Idx.ETA_RATE]
-        x[Idx.ETA] = eta + eta_rate * dt
-        x[Idx.ETA_RATE] = eta_rate + (-w * w * eta - 2.0 * z * w * eta_rate) * dt
-        F[Idx.ETA, Idx.ETA_RATE] = dt
-        F[Idx.ETA_RATE, Idx.ETA] = -w * w * dt
-        F[Idx.ETA_RATE, Idx.ETA_RATE] = 1.0 - 2.0 * z * w * dt
+        eta, eta_rate = x[_ETA], x[_ETA_RATE]
+        x[_ETA] = eta + eta_rate * dt
+        x[_ETA_RATE] = eta_rate + (-w * w * eta - 2.0 * z * w * eta_rate) * dt
+        F[_ETA, _ETA_RATE] = dt
+        F[_ETA_RATE, _ETA] = -w * w * dt
+        F[_ETA_RATE, _ETA_RATE] = 1.0 - 2.0 * z * w * dt
         decay = 1.0 - dt / n.gps_bias_tau_s
-        x[Idx.GPS_BIAS_E] *= decay
-        x[Idx.GPS_BIAS_N] *= decay
-        F[Idx.GPS_BIAS_E, Idx.GPS_BIAS_E] = F[Idx.GPS_BIAS_N, Idx.GPS_BIAS_N] = decay
+        x[_GBE] *= decay
+        x[_GBN] *= decay
+        F[_GBE, _GBE] = F[_GBN, _GBN] = decay
         bias_q = 2.0 * n.gps_bias_sigma_m ** 2 / n.gps_bias_tau_s
         accel = n.accel_mps2 if accel_noise_mps2 is None else accel_noise_mps2
         q = np.array([n.position_m ** 2, n.position_m ** 2, n.yaw_rad ** 2, accel ** 2,
@@ -154,7 +159,9 @@ class MotionEkf:
 
     def update(self, z: np.ndarray, hx: np.ndarray, H: np.ndarray, R: np.ndarray,
                gate: float, angle_rows: tuple[int, ...] = ()) -> Outcome:
-        """Gated EKF update (Joseph form). Rejects when the Mahalanobis distance > ``gate``."""
+        """Gated EKF update. The whole vector is gated on its Mahalanobis distance (rejected
+        above ``gate``); with a diagonal R it is then applied row by row (exact, and cheaper
+        than the matrix form), else in Joseph form."""
         y = np.asarray(z, dtype=float) - hx
         for row in angle_rows:
             y[row] = wrap_angle(y[row])
@@ -167,9 +174,16 @@ class MotionEkf:
         d2 = float(y @ S_inv @ y)
         if not math.isfinite(d2) or d2 > gate * gate:
             return Outcome.REJECTED_OUTLIER
+        if not np.count_nonzero(R - np.diag(np.diag(R))):
+            x_start = self.x.copy()
+            for row in range(H.shape[0]):
+                # a later row's residual moves with the state the earlier rows corrected
+                residual = y[row] - float(H[row] @ (self.x - x_start))
+                self.update_scalar(residual, 0.0, H[row], float(R[row, row]), math.inf)
+            return Outcome.ACCEPTED
         K = PHt @ S_inv
         self.x += K @ y
-        self.x[Idx.YAW] = wrap_angle(self.x[Idx.YAW])
+        self.x[_YAW] = wrap_angle(self.x[_YAW])
         I_KH = self._eye - K @ H
         self.P = I_KH @ self.P @ I_KH.T + K @ R @ K.T
         return Outcome.ACCEPTED
@@ -191,14 +205,17 @@ class MotionEkf:
         if not s > 0.0 or y * y > gate * gate * s:
             return Outcome.REJECTED_OUTLIER
         k = Ph / s
-        if only is not None:
+        if only is None:
+            self.x += k * y
+            self.P -= k[:, None] * Ph[None, :]          # optimal gain: P - k (P h)^T
+        else:
             k = k * only
-        self.x += k * y
-        self.x[Idx.YAW] = wrap_angle(self.x[Idx.YAW])
-        # Joseph form for one row, valid for any gain k:
-        # (I - k h) P (I - k h)^T + k var k^T = P - k Ph^T - Ph k^T + k k^T (h P h + var)
-        kh_p = np.outer(k, Ph)
-        self.P = self.P - kh_p - kh_p.T + np.outer(k, k) * s
+            self.x += k * y
+            # Joseph form for one row, valid for any gain k:
+            # (I - k h) P (I - k h)^T + k var k^T = P - k Ph^T - Ph k^T + k k^T (h P h + var)
+            kh_p = k[:, None] * Ph[None, :]
+            self.P = self.P - kh_p - kh_p.T + (k[:, None] * k[None, :]) * s
+        self.x[_YAW] = wrap_angle(self.x[_YAW])
         return Outcome.ACCEPTED
 
     def set_pose(self, x_m: float, y_m: float, yaw_rad: float, sigma_pos_m: float,

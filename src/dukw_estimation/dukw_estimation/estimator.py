@@ -7,7 +7,6 @@ filter goes on predicting without it (robot_localization's behaviour).
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections import defaultdict
 
@@ -75,6 +74,7 @@ class Estimator:
         self.position_set = False
         self.yaw_set = False
         self.imu: ImuSample | None = None
+        self.accel_base = (math.nan, math.nan, math.nan)   # specific force at base_link
         self.tracks: DriveStatus | None = None
         self.props: DriveStatus | None = None
         self.slope_rad = self.vehicle.site.beach_slope_rad
@@ -127,13 +127,14 @@ class Estimator:
         accel = None
         noise = None
         target = None
-        if imu is not None and self._fresh('imu', now) and math.isfinite(imu.accel_x_mps2):
+        if imu is not None and self._fresh('imu', now) and math.isfinite(self.accel_base[0]):
             # gravity along the body axes from the attitude, scaled by the measured vertical
             # specific force (heave accelerations afloat): g_up = f_z / (cos roll cos pitch)
+            fx, fy, fz = self.accel_base
             tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
-            g_up = imu.accel_z_mps2 / max(tilt, 0.5)
-            accel = (imu.accel_x_mps2 + g_up * math.sin(imu.pitch_rad) + x[Idx.R] * x[Idx.V],
-                     imu.accel_y_mps2 - g_up * math.sin(imu.roll_rad) * math.cos(imu.pitch_rad)
+            g_up = fz / max(tilt, 0.5)
+            accel = (fx + g_up * math.sin(imu.pitch_rad) + x[Idx.R] * x[Idx.V],
+                     fy - g_up * math.sin(imu.roll_rad) * math.cos(imu.pitch_rad)
                      - x[Idx.R] * x[Idx.U])
         else:
             noise = st.q_accel_no_imu_mps2
@@ -179,8 +180,9 @@ class Estimator:
         if rejected:
             return rejected
         dt = s.t_s - self.imu.t_s if self.imu is not None else 0.0
-        self.imu = self._imu_at_base_link(s, dt)
-        self._update_motion(self.imu, dt)
+        self.accel_base = self._accel_at_base_link(s, dt)
+        self.imu = s
+        self._update_motion(s, dt)
         st = self.settings
         h = np.zeros(N_STATES)
         h[Idx.R] = h[Idx.BIAS] = 1.0
@@ -201,8 +203,8 @@ class Estimator:
         self._update_slope(s, dt)
         return self._count('imu', out)
 
-    def _imu_at_base_link(self, s: ImuSample, dt: float) -> ImuSample:
-        """Move the specific force from the IMU (sensors.imu_z_m above base_link) to base_link.
+    def _accel_at_base_link(self, s: ImuSample, dt: float) -> tuple[float, float, float]:
+        """The specific force moved from the IMU (sensors.imu_z_m above base_link) to base_link.
 
         A point at r = (0, 0, h) feels alpha x r + w x (w x r) more than base_link; alpha comes
         from differencing the gyro (roll and pitch rates), which matters afloat.
@@ -215,17 +217,16 @@ class Estimator:
         else:
             alpha_x = alpha_y = 0.0
         wx, wy, wz = s.roll_rate_rps, s.pitch_rate_rps, s.yaw_rate_rps
-        return dataclasses.replace(
-            s, accel_x_mps2=s.accel_x_mps2 - (alpha_y + wz * wx) * h,
-            accel_y_mps2=s.accel_y_mps2 + (alpha_x - wz * wy) * h,
-            accel_z_mps2=s.accel_z_mps2 + (wx * wx + wy * wy) * h)
+        return (s.accel_x_mps2 - (alpha_y + wz * wx) * h,
+                s.accel_y_mps2 + (alpha_x - wz * wy) * h,
+                s.accel_z_mps2 + (wx * wx + wy * wy) * h)
 
     def _update_motion(self, s: ImuSample, dt: float) -> None:
         """Low-pass of (roll/pitch rate, heave acceleration) over their thresholds, squared."""
         st = self.settings
         tilt = math.cos(s.roll_rad) * math.cos(s.pitch_rad)
-        heave = s.accel_z_mps2 / max(tilt, 0.5) - self.vehicle.body.gravity_mps2 \
-            if math.isfinite(s.accel_z_mps2) else 0.0
+        fz = self.accel_base[2]
+        heave = fz / max(tilt, 0.5) - self.vehicle.body.gravity_mps2 if math.isfinite(fz) else 0.0
         level = ((s.roll_rate_rps ** 2 + s.pitch_rate_rps ** 2) / st.contact_rate_rps ** 2
                  + heave ** 2 / st.contact_accel_mps2 ** 2)
         alpha = min(dt / st.contact_time_constant_s, 1.0) if dt > 0.0 else 1.0
@@ -306,6 +307,9 @@ class Estimator:
         rejected = self._admit('water', s.t_s, ())
         if rejected:
             return rejected
+        if self.afloat:
+            # floating, the sensors ride with the hull, not at a height above the sand
+            return self._count('water', Outcome.ACCEPTED)
         mounts = self.vehicle.sensors
         out = Outcome.IGNORED
         for wet, x_m, z_m in ((s.fore_wet, mounts.fore_water_x_m, mounts.fore_water_z_m),
@@ -465,11 +469,12 @@ class Estimator:
         """Floating: the displacement, plus what the heave acceleration says (IMU fresh)."""
         body = self.vehicle.body
         imu = self.imu
-        if imu is None or not math.isfinite(imu.accel_z_mps2) or self.t_s is None \
+        fz = self.accel_base[2]
+        if imu is None or not math.isfinite(fz) or self.t_s is None \
                 or not self._fresh('imu', self.t_s):
             return body.displaced_volume_m3
         tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
-        heave_accel = imu.accel_z_mps2 / max(tilt, 0.5) - body.gravity_mps2
+        heave_accel = fz / max(tilt, 0.5) - body.gravity_mps2
         volume = buoyancy.afloat_dynamic_volume_m3(body.displacement_n, self.heave_mass_kg,
                                                    heave_accel, body.water_density_kgpm3,
                                                    body.gravity_mps2)
