@@ -38,6 +38,8 @@ class CoreAdapter(ABC):
     outputs: tuple[str, ...] = ()
     #: the node's timer rate, Hz
     rate_hz: float = 1.0
+    #: quantities that are angles, rad: compared modulo 2 pi
+    angle_quantities: frozenset[str] = frozenset()
 
     @abstractmethod
     def feed(self, topic: str, t_s: float, msg: Any) -> dict[str, float] | None:
@@ -136,6 +138,8 @@ class _Driver:
             dev = self.deviations.setdefault(quantity, Deviation(self.adapter.name, quantity))
             mine = replayed.get(quantity, math.nan)
             diff = 0.0 if math.isnan(mine) and math.isnan(value) else abs(mine - value)
+            if quantity in self.adapter.angle_quantities and diff > math.pi:
+                diff = abs(math.remainder(mine - value, math.tau))
             dev.compared += 1
             worse = (dev.compared == 1 or diff > dev.max_abs
                      or (math.isnan(diff) and not math.isnan(dev.max_abs)))

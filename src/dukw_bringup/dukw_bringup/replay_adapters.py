@@ -143,6 +143,7 @@ class EkfAdapter(CoreAdapter):
     inputs = ('imu/data', 'gps/fix', 'gps/vel', 'water/contact', 'depth', 'tracks/status',
               'props/status')
     outputs = ('odometry/filtered', 'traction')
+    angle_quantities = frozenset({'odom.yaw_rad'})
     #: traction fields compared (the message's float fields)
     TRACTION_FIELDS = ('port_slip', 'stbd_slip', 'submerged_volume_m3', 'effective_weight_n',
                        'weight_on_tracks_fraction', 'waterline_distance_m',

@@ -122,3 +122,19 @@ def test_an_immediate_reaction_is_the_latest_output(tmp_path):
     result = replay(tmp_path / 'bag', [ReactingCore()])
     assert result.exceeding({}, 0.0) == []
     assert [row['t_s'] for row in result.rows['react']] == pytest.approx([0.1, 0.15])
+
+
+class AngleCore(SumCore):
+    """Reports its total as an angle."""
+
+    name = 'angle'
+    angle_quantities = frozenset({'total'})
+
+
+def test_angles_are_compared_modulo_two_pi(tmp_path):
+    # replayed totals 3, 5, 7 rad; recorded 3 - 2 pi, 5 + 2 pi, 7.5 (the last really moved)
+    tau = 2 * math.pi
+    bag = _bag(tmp_path / 'bag', [(100, 3.0 - tau, 1.0), (200, 5.0 + tau, 2.0),
+                                  (300, 7.5, 3.0)])
+    dev = replay(bag, [AngleCore()]).deviations['angle']['total']
+    assert dev.max_abs == pytest.approx(0.5) and dev.at_s == pytest.approx(0.3)
