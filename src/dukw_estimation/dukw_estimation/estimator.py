@@ -267,17 +267,21 @@ class Estimator:
         a, b, _, _ = self._lever_arm()
         c, sn = math.cos(x[Idx.YAW]), math.sin(x[Idx.YAW])
         offset = np.array([c * a + sn * b, sn * a - c * b])
-        if not self.position_set:
+        var = s.horizontal_var_m2 if s.horizontal_var_m2 > 0 and self.settings.gps_bias_sigma_m \
+            == 0.0 else self.settings.gps_position_m ** 2
+        if not self.position_set:      # the first fix: start there, as sure as the fix is
             x[Idx.X], x[Idx.Y] = east - offset[0], north - offset[1]
+            for i in (Idx.X, Idx.Y):
+                self.ekf.P[i, :] = 0.0
+                self.ekf.P[:, i] = 0.0
+                self.ekf.P[i, i] = var + self.settings.gps_bias_sigma_m ** 2
             self._init_waterline()
             self.position_set = True
         H = np.zeros((2, N_STATES))
         H[0, Idx.X] = H[1, Idx.Y] = H[0, Idx.GPS_BIAS_E] = H[1, Idx.GPS_BIAS_N] = 1.0
         H[0, Idx.YAW] = -sn * a + c * b
         H[1, Idx.YAW] = c * a + sn * b
-        # with bias states the message's covariance (the total error) is not the white part
-        var = s.horizontal_var_m2 if s.horizontal_var_m2 > 0 and self.settings.gps_bias_sigma_m \
-            == 0.0 else self.settings.gps_position_m ** 2
+        # (with bias states the message's covariance, the total error, is not the white part)
         predicted = x[[Idx.X, Idx.Y]] + offset + x[[Idx.GPS_BIAS_E, Idx.GPS_BIAS_N]]
         out = self.ekf.update(np.array([east, north]), predicted, H, np.eye(2) * var,
                               self.settings.gate_gps_fix)
