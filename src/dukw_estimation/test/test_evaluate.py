@@ -1,0 +1,42 @@
+"""Accuracy on simulator runs (issue 5): the evaluate tool's scenarios, offline, scored."""
+import json
+
+import pytest
+
+from dukw_estimation import evaluate
+
+DURATION_S = 20.0      # shorter than the tool's 30 s default: every transition is complete by then
+MOTION = ('position_rmse_m', 'heading_rmse_deg', 'slip_rmse')
+SUBMERSION = ('volume_error_pct', 'fraction_error')
+#: Known gap (see the README): in the 28 cm sea the instantaneous wave at the hull while the
+#: tracks touch is only seen through the two wet/dry sensors, and the volume error can exceed
+#: 10 % of the displacement volume. Checked, and reported as xfail when it does.
+ROUGH_SEA = {s.name for s in evaluate.scenarios() if s.wave_height_m > 0.2}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize('scenario', evaluate.scenarios(), ids=lambda s: s.name)
+def test_scenario_meets_the_accuracy_targets(scenario):
+    result = evaluate.run_scenario(scenario, DURATION_S, seed=0)
+    for key in MOTION:
+        assert result[key] <= evaluate.TARGETS[key], (key, result)
+    assert sum(result['rejected'].values()) <= 20, result       # a clean run, few outliers
+    missed = {k: result[k] for k in SUBMERSION if result[k] > evaluate.TARGETS[k]}
+    if missed and scenario.name in ROUGH_SEA:
+        pytest.xfail(f'known gap in the 28 cm sea: {missed}')
+    assert not missed, result
+
+
+def test_cli_prints_one_json_object_per_scenario(capsys):
+    code = evaluate.main(['--scenario', 'land_circle', '--duration', '4'])
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert len(lines) == 1
+    result = json.loads(lines[0])
+    assert result['scenario'] == 'land_circle'
+    assert set(evaluate.TARGETS) <= set(result)
+    assert code == (0 if result['targets_met'] else 1)
+
+
+def test_cli_refuses_a_run_shorter_than_the_warm_up():
+    with pytest.raises(SystemExit):
+        evaluate.main(['--duration', '1'])
