@@ -63,8 +63,8 @@ SCENARIOS = {s.name: s for s in (
     Scenario('land_to_sea', 'from the sand 0.5 m above the waterline straight out to sea: '
              'LAND -> TRANSITION -> WATER', start_x_m=-0.5, start_yaw_rad=0.0,
              duration_s=9.0, seed=12, cmd_vel=_straight(1.2)),
-    Scenario('sea_to_land', 'afloat 7.5 m out, bow to the beach, up onto the sand: '
-             'WATER -> TRANSITION -> LAND', start_x_m=7.5, start_yaw_rad=math.pi,
+    Scenario('sea_to_land', 'afloat 6.8 m out, bow to the beach, up onto the sand: '
+             'WATER -> TRANSITION -> LAND', start_x_m=6.8, start_yaw_rad=math.pi,
              duration_s=10.0, seed=13, cmd_vel=_straight(1.2)),
 )}
 
