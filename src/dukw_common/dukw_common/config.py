@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+from dataclasses import fields
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -111,3 +112,25 @@ def section(params: Mapping[str, ParamValue], prefix: str) -> dict[str, ParamVal
     """Return the parameters under ``prefix.`` with the prefix stripped."""
     cut = prefix.rstrip('.') + '.'
     return {k[len(cut):]: v for k, v in params.items() if k.startswith(cut)}
+
+
+_KINDS = {'float': float, 'int': int, 'str': str, 'bool': bool}
+
+
+def build_settings(cls: type, params: Mapping[str, ParamValue], prefix: str):
+    """Build settings dataclass ``cls`` from the dotted parameters ``<prefix>.<field>``.
+
+    Each field's annotation (float, int, str, bool) gives the conversion; a
+    missing or ill-typed value raises ConfigError naming ``<prefix>.<field>``.
+    """
+    values = {}
+    for f in fields(cls):
+        name = f'{prefix}.{f.name}'
+        kind = _KINDS[f.type if isinstance(f.type, str) else f.type.__name__]
+        if kind is bool:
+            if not isinstance(params.get(name), bool):
+                raise ConfigError(f'parameter {name!r} must be true or false')
+            values[f.name] = params[name]
+        else:
+            values[f.name] = require(params, name, kind)
+    return cls(**values)

@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Mapping
 
-from dukw_common.config import ConfigError, ParamValue, require, section
+from dukw_common.config import ConfigError, ParamValue, build_settings, section
 
 
 @dataclass(frozen=True)
@@ -116,39 +116,29 @@ class SiteParams:
     sea_floor_depth_m: float
 
 
-def _build(cls: type, params: Mapping[str, ParamValue], prefix: str):
-    sub = section(params, prefix)
-    names = [f for f in cls.__dataclass_fields__]
-    return cls(**{n: require(sub, n) if n in sub else _missing(prefix, n) for n in names})
-
-
-def _missing(prefix: str, name: str):
-    raise ConfigError(f'missing parameter {prefix}.{name!s}')
-
-
 def vehicle_params(params: Mapping[str, ParamValue]) -> VehicleParams:
     """Build VehicleParams from dotted parameters (``vehicle.*``)."""
-    return _build(VehicleParams, params, 'vehicle')
+    return build_settings(VehicleParams, params, 'vehicle')
 
 
 def sensor_mounts(params: Mapping[str, ParamValue]) -> SensorMounts:
     """Build SensorMounts from dotted parameters (``sensors.*``)."""
-    return _build(SensorMounts, params, 'sensors')
+    return build_settings(SensorMounts, params, 'sensors')
 
 
 def drivetrain_params(params: Mapping[str, ParamValue]) -> DrivetrainParams:
     """Build DrivetrainParams from dotted parameters (``drivetrain.*``)."""
-    return _build(DrivetrainParams, params, 'drivetrain')
+    return build_settings(DrivetrainParams, params, 'drivetrain')
 
 
 def limit_params(params: Mapping[str, ParamValue]) -> LimitParams:
     """Build LimitParams from dotted parameters (``limits.*``)."""
-    return _build(LimitParams, params, 'limits')
+    return build_settings(LimitParams, params, 'limits')
 
 
 def site_params(params: Mapping[str, ParamValue]) -> SiteParams:
     """Build SiteParams from dotted parameters (``site.*``)."""
-    return _build(SiteParams, params, 'site')
+    return build_settings(SiteParams, params, 'site')
 
 
 def soil_params(params: Mapping[str, ParamValue], preset: str | None = None) -> SoilParams:
@@ -158,8 +148,8 @@ def soil_params(params: Mapping[str, ParamValue], preset: str | None = None) -> 
         if not sub:
             names = params.get('soil_presets.names', [])
             raise ConfigError(f'unknown soil preset {preset!r}; known: {names}')
-        return _build(SoilParams, params, f'soil_presets.{preset}')
-    return _build(SoilParams, params, 'soil')
+        return build_settings(SoilParams, params, f'soil_presets.{preset}')
+    return build_settings(SoilParams, params, 'soil')
 
 
 @dataclass(frozen=True)

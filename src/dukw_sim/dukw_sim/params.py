@@ -5,10 +5,10 @@ Every value's source is in config/dukw.yaml; nothing here has a default.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from typing import Mapping
 
-from dukw_common.config import ConfigError, ParamValue, require, section
+from dukw_common.config import ConfigError, ParamValue, build_settings, require
 from dukw_common.vehicle import SoilParams, soil_params
 
 from dukw_sim.world import WaveModel
@@ -16,18 +16,6 @@ from dukw_sim.world import WaveModel
 # Override names accepted for the shared site block (the world's beach lives there).
 SITE_ALIASES = {'world.beach_slope_rad': 'site.beach_slope_rad',
                 'world.sea_floor_depth_m': 'site.sea_floor_depth_m'}
-
-
-def _build(cls: type, params: Mapping[str, ParamValue], prefix: str):
-    """Build a frozen settings dataclass from the dotted parameters under ``prefix``."""
-    sub = section(params, prefix)
-    values = {}
-    for f in fields(cls):
-        if f.name not in sub:
-            raise ConfigError(f'missing parameter {prefix}.{f.name}')
-        kind = {'float': float, 'int': int, 'str': str}[f.type]
-        values[f.name] = require(sub, f.name, kind)
-    return cls(**values)
 
 
 def _positive(obj, *names: str) -> None:
@@ -165,16 +153,16 @@ class SimParams:
     @classmethod
     def from_params(cls, params: Mapping[str, ParamValue]) -> 'SimParams':
         """Build from dotted parameters (the sim_node block overlaid on the shared one)."""
-        world = _build(WorldParams, params, 'world')
+        world = build_settings(WorldParams, params, 'world')
         dry = soil_params(params, world.dry_soil_preset) if world.dry_soil_preset else None
         dt = require(params, 'physics.dt_s')
         if not 0.0 < dt <= 0.02:
             raise ConfigError('physics.dt_s must be in (0, 0.02] s')
         out = cls(dt, require(params, 'physics.battery_internal_resistance_ohm'), world,
-                  _build(WaveParams, params, 'waves'), _build(LandParams, params, 'land'),
-                  _build(WaterParams, params, 'water'),
-                  _build(SeakeepingParams, params, 'seakeeping'),
-                  _build(StartParams, params, 'start'), dry)
+                  build_settings(WaveParams, params, 'waves'), build_settings(LandParams, params, 'land'),
+                  build_settings(WaterParams, params, 'water'),
+                  build_settings(SeakeepingParams, params, 'seakeeping'),
+                  build_settings(StartParams, params, 'start'), dry)
         return out
 
 

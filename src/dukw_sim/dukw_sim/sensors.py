@@ -22,7 +22,7 @@ from typing import Mapping
 
 import numpy as np
 
-from dukw_common.config import ConfigError, ParamValue, node_params, require
+from dukw_common.config import ConfigError, ParamValue, build_settings, node_params, require
 from dukw_common.geometry import geodetic_from_local_enu, quaternion_from_euler
 from dukw_common.vehicle import (DrivetrainParams, SensorMounts, drivetrain_params,
                                   sensor_mounts)
@@ -217,19 +217,13 @@ _SIGNED = {'datum_lat_deg', 'datum_lon_deg', 'datum_alt_m', 'offset_m', 'water_t
 
 
 def _group(cls: type, params: Mapping[str, ParamValue], prefix: str):
-    """Build dataclass ``cls`` from ``<prefix>.<field>`` parameters; ConfigError if bad."""
-    values = {}
-    for name, fld in cls.__dataclass_fields__.items():
-        key = f'{prefix}.{name}'
-        if fld.type == 'int':
-            values[name] = require(params, key, int)
-            if values[name] < 1:
-                raise ConfigError(f'parameter {key!r} must be >= 1, got {values[name]}')
-        elif name in _SIGNED:
-            values[name] = require(params, key)
-        else:
-            values[name] = _non_negative(params, key)
-    return cls(**values)
+    """Build dataclass ``cls`` from ``<prefix>.<field>``; counts >= 1, magnitudes >= 0."""
+    settings = build_settings(cls, params, prefix)
+    for name, value in vars(settings).items():
+        low = 1 if isinstance(value, int) else 0.0
+        if name not in _SIGNED and value < low:
+            raise ConfigError(f'parameter {prefix + "." + name!r} must be >= {low}, got {value}')
+    return settings
 
 
 @dataclass(frozen=True)
@@ -263,13 +257,6 @@ class SensorConfig:
     def from_config(cls, path: str | None = None) -> 'SensorConfig':
         """Load from a parameter file (default: the stack's config/dukw.yaml)."""
         return cls.from_params(node_params(NODE_NAME, path))
-
-
-def _non_negative(params: Mapping[str, ParamValue], name: str) -> float:
-    value = require(params, name)
-    if value < 0:
-        raise ConfigError(f'parameter {name!r} must be >= 0, got {value}')
-    return value
 
 
 def _positive(params: Mapping[str, ParamValue], name: str) -> float:
