@@ -159,7 +159,8 @@ class SimParams:
         if not 0.0 < dt <= 0.02:
             raise ConfigError('physics.dt_s must be in (0, 0.02] s')
         out = cls(dt, require(params, 'physics.battery_internal_resistance_ohm'), world,
-                  build_settings(WaveParams, params, 'waves'), build_settings(LandParams, params, 'land'),
+                  build_settings(WaveParams, params, 'waves'),
+                  build_settings(LandParams, params, 'land'),
                   build_settings(WaterParams, params, 'water'),
                   build_settings(SeakeepingParams, params, 'seakeeping'),
                   build_settings(StartParams, params, 'start'), dry)
