@@ -42,7 +42,7 @@ def cpu_seconds(pid: int) -> float:
 
 def run(factor: float, seconds: float, executor: str) -> dict:
     """One sim_node process at ``factor``; return the figures."""
-    env = {'DUKW_SIM_EXECUTOR': executor}
+    env = {'DUKW_EXECUTOR': executor}
     proc = NodeProcess('dukw_sim', 'sim_node',
                        ['--ros-args', '-p', f'real_time_factor:={factor}'], env=env)
     context = Context()

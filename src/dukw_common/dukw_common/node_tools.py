@@ -4,6 +4,7 @@ This is the only module of dukw_common that imports rclpy.
 """
 from __future__ import annotations
 
+import os
 import signal
 import sys
 import threading
@@ -12,6 +13,7 @@ from typing import Callable, Sequence
 
 import rclpy
 from rclpy.executors import Executor, SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy,
@@ -94,14 +96,31 @@ def parameter_overrides(overrides: dict[str, ParamValue]) -> list[Parameter]:
     return [Parameter(k, value=v) for k, v in overrides.items()]
 
 
+EXECUTOR_ENV = 'DUKW_EXECUTOR'
+
+
+def default_executor() -> Executor:
+    """The executor every node spins: rclpy's EventsExecutor, or ``DUKW_EXECUTOR=single``.
+
+    Measured on the 2-core target (benchmarks/bench_stack.py): the
+    SingleThreadedExecutor rebuilds its wait set for every callback and cost the
+    stack without the simulator more than a whole core at 100 Hz; the
+    EventsExecutor does the same work for a fraction. It must be spun with a
+    timeout (platform.md), which run_node does.
+    """
+    if os.environ.get(EXECUTOR_ENV, 'events') == 'single':
+        return SingleThreadedExecutor()
+    return EventsExecutor()
+
+
 def run_node(factory: Callable[[], Node], args: list[str] | None = None,
-             executor_factory: Callable[[], Executor] = SingleThreadedExecutor) -> int:
+             executor_factory: Callable[[], Executor] = default_executor) -> int:
     """Run one node until SIGINT/SIGTERM, then let it stop safely and exit 0.
 
     The node may define ``on_shutdown()``: it runs while the context is still up,
     so it can publish a last neutral command. A ConfigError at construction
     prints a clear message and exits 2. ``executor_factory`` may give another
-    executor (e.g. rclpy.experimental.EventsExecutor; it is spun with a timeout).
+    executor; every executor is spun with a timeout.
     """
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     stop = threading.Event()

@@ -1,16 +1,12 @@
 """sim_node: the simulator behind exactly the drivers' topics, on sim time (/clock).
 
-Spun by rclpy's EventsExecutor: at a paced real-time factor it costs less CPU per
-timer tick than the default executor (benchmarks/bench_sim_node.py compares them);
-DUKW_SIM_EXECUTOR=single selects the SingleThreadedExecutor.
+Spun, like every node, by run_node's default executor (the EventsExecutor;
+DUKW_EXECUTOR=single selects the SingleThreadedExecutor for comparison).
 """
-import os
 import time
 
 from dukw_msgs.msg import DiffCommand
 from dukw_msgs.srv import SetOperator
-from rclpy.executors import SingleThreadedExecutor
-from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 
 from dukw_common.config import ConfigError
@@ -130,9 +126,7 @@ class SimNode(Node):
 
 def main(args=None) -> int:
     """Console-script entry point."""
-    executor = (SingleThreadedExecutor if os.environ.get('DUKW_SIM_EXECUTOR') == 'single'
-                else EventsExecutor)
-    return run_node(SimNode, args, executor)
+    return run_node(SimNode, args)
 
 
 if __name__ == '__main__':
