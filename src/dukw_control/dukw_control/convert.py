@@ -73,7 +73,6 @@ class ActuatorPublishers:
         self.publish(NEUTRAL, NEUTRAL)
 
 
-def pitch_from_imu(msg) -> float:
-    """REP 103 pitch (positive nose down) from a sensor_msgs/Imu orientation."""
-    q = msg.orientation
+def pitch_from_quaternion(q) -> float:
+    """REP 103 pitch (positive nose down) from a geometry_msgs/Quaternion."""
     return euler_from_quaternion(q.x, q.y, q.z, q.w)[1]

@@ -8,7 +8,6 @@ from dukw_msgs.msg import Authority, DrivetrainStatus, DriveMode, Traction
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
-from sensor_msgs.msg import Imu
 
 from dukw_common.config import ConfigError
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
@@ -16,7 +15,7 @@ from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpe
                                     vehicle_specs)
 from dukw_control.controller import NODE_PARAMS, DriveController, settings_from_params
 from dukw_control.convert import (ActuatorPublishers, authority_usable, decision_from_msg,
-                                  pitch_from_imu)
+                                  pitch_from_quaternion)
 
 
 class DriveControllerNode(Node):
@@ -25,6 +24,7 @@ class DriveControllerNode(Node):
     def __init__(self) -> None:
         super().__init__('drive_controller_node')
         specs = [ParamSpec(n, d, min=lo, max=hi) for n, d, lo, hi in NODE_PARAMS]
+        specs.append(ParamSpec('step_on_odometry', 'run a control step on each estimate'))
         params = declare_parameters(self, specs + vehicle_specs('vehicle', 'drivetrain',
                                                                 'limits'))
         try:
@@ -37,13 +37,15 @@ class DriveControllerNode(Node):
         self.create_subscription(Authority, 'authority', self.on_authority, STATE_QOS)
         self.create_subscription(DriveMode, 'drive_mode', self.on_mode, STATE_QOS)
         self.create_subscription(Odometry, 'odometry/filtered', self.on_odometry, SENSOR_QOS)
-        self.create_subscription(Imu, 'imu/data', self.on_imu, SENSOR_QOS)
         self.create_subscription(Traction, 'traction', self.on_traction, SENSOR_QOS)
         self.create_subscription(DrivetrainStatus, 'tracks/status', self.on_tracks, SENSOR_QOS)
         self.create_subscription(DrivetrainStatus, 'props/status', self.on_props, SENSOR_QOS)
         self.props_connected = None
         self.last_reason = None
-        self.create_timer(1.0 / params['rate_hz'], self.on_timer)
+        self.step_on_odometry = bool(params['step_on_odometry'])
+        self.period_s = 1.0 / params['rate_hz']
+        self.last_event_step_s = -1.0
+        self.create_timer(self.period_s, self.on_tick)
         self.create_timer(params['diagnostics_period_s'], self.publish_diagnostics)
 
     def now_s(self) -> float:
@@ -65,11 +67,16 @@ class DriveControllerNode(Node):
         self.core.on_mode(decision_from_msg(msg))
 
     def on_odometry(self, msg: Odometry) -> None:
-        self.core.on_odometry(msg.twist.twist.linear.x, msg.twist.twist.angular.z,
-                              self.now_s())
+        now = self.now_s()
+        self.core.on_odometry(msg.twist.twist.linear.x, msg.twist.twist.angular.z, now)
+        self.core.on_pitch(pitch_from_quaternion(msg.pose.pose.orientation), now)
+        if self.step_on_odometry:
+            self.last_event_step_s = now
+            self.on_timer()
 
-    def on_imu(self, msg: Imu) -> None:
-        self.core.on_pitch(pitch_from_imu(msg), self.now_s())
+    def on_tick(self) -> None:
+        if self.now_s() - self.last_event_step_s >= 1.5 * self.period_s:
+            self.on_timer()          # the estimator is silent: keep the guards running
 
     def on_traction(self, msg: Traction) -> None:
         self.core.on_slips(msg.port_slip, msg.stbd_slip, self.now_s())

@@ -13,7 +13,7 @@ from dukw_common.config import ConfigError
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
                                     declare_parameters, run_node, vehicle_specs)
 from dukw_common.vehicle import drivetrain_params, limit_params
-from dukw_control.convert import ActuatorPublishers, authority_usable, pitch_from_imu
+from dukw_control.convert import ActuatorPublishers, authority_usable, pitch_from_quaternion
 from dukw_control.guards import InclineGuard
 from dukw_control.limits import CurrentLimiter, CurrentLimitSettings
 from dukw_control.maneuvers import ManeuverPlan, ManeuverPlayer, PlayerState
@@ -80,7 +80,7 @@ class ManeuverNode(Node):
             self.on_timer()          # neutral at once
 
     def on_imu(self, msg: Imu) -> None:
-        self.incline_rad = -pitch_from_imu(msg)
+        self.incline_rad = -pitch_from_quaternion(msg.orientation)
 
     def on_tracks(self, msg: DrivetrainStatus) -> None:
         now = self.now_s()

@@ -6,7 +6,7 @@ from dukw_msgs.msg import Authority, DiffCommand, DrivetrainStatus, DriveMode, T
 from dukw_msgs.msg import WaterContact
 from dukw_msgs.srv import SetMode
 from geometry_msgs.msg import Twist
-from sensor_msgs.msg import Imu
+from nav_msgs.msg import Odometry
 
 from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS, stamp_to_s
 from dukw_common.testing import NodeProcess, ros_node, spin_until
@@ -34,7 +34,7 @@ class Probe:
         self.node = node
         self.pubs = {name: node.create_publisher(kind, name, qos) for name, kind, qos in (
             ('authority', Authority, STATE_QOS), ('drive_mode', DriveMode, STATE_QOS),
-            ('cmd_vel', Twist, COMMAND_QOS), ('imu/data', Imu, SENSOR_QOS),
+            ('cmd_vel', Twist, COMMAND_QOS), ('odometry/filtered', Odometry, SENSOR_QOS),
             ('tracks/status', DrivetrainStatus, SENSOR_QOS))}
         self.tracks = []
         node.create_subscription(DiffCommand, 'tracks/cmd', self.tracks.append, COMMAND_QOS)
@@ -46,9 +46,9 @@ class Probe:
         return self.node.get_clock().now().nanoseconds * 1e-9
 
     def tick(self):
-        imu = Imu()
-        imu.orientation.w = 1.0
-        self.pubs['imu/data'].publish(imu)
+        odom = Odometry()              # level, standing: pitch 0 for the incline guard
+        odom.pose.pose.orientation.w = 1.0
+        self.pubs['odometry/filtered'].publish(odom)
         self.pubs['tracks/status'].publish(tracks_status())
         if self.sending_cmd:
             twist = Twist()

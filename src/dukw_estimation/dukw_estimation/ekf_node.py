@@ -32,11 +32,15 @@ class EkfNode(Node):
         super().__init__('ekf_node', **node_kwargs)
         specs = [ParamSpec(n, d, min=lo, max=hi) for n, d, lo, hi in setting_specs()]
         specs += vehicle_specs()
+        specs.append(ParamSpec('publish_on_imu', 'publish after each IMU sample, not only on '
+                               'the timer'))
         specs += [ParamSpec(f'soil_presets.{name}', 'soil preset value (vehicle.md 6)', min=0.0)
                   for name in section(node_params('ekf_node'), 'soil_presets')
                   if name != 'names']
         params = declare_parameters(self, specs)
         self.settings = EkfSettings.from_params(params)
+        self.publish_on_imu = bool(params['publish_on_imu'])
+        self.last_event_publish_s = -1.0
         soil = soil_params(params, self.settings.soil_preset or None)
         self.estimator = Estimator(Vehicle.from_params(params), self.settings, soil)
         self.odom_pub = self.create_publisher(Odometry, 'odometry/filtered', COMMAND_QOS)
@@ -61,17 +65,27 @@ class EkfNode(Node):
         return self.get_clock().now().nanoseconds * 1e-9
 
     def _handler(self, convert, add):
+        publish = self.publish_on_imu and add == self.estimator.add_imu
+
         def callback(msg) -> None:
-            add(convert(msg, conv.stamp_or(msg, self._now_s())))
+            now = self._now_s()
+            add(convert(msg, conv.stamp_or(msg, now)))
+            if publish and self.estimator.t_s is not None:
+                self.last_event_publish_s = now
+                self._publish()
         return callback
 
     def _on_timer(self) -> None:
         est = self.estimator
-        if est.t_s is None:
-            return  # nothing measured yet
         now = self._now_s()
+        if est.t_s is None or now - self.last_event_publish_s < 1.5 / self.settings.rate_hz:
+            return  # nothing measured yet, or the IMU drives the output
         if 0.0 < now - est.t_s <= self.settings.sensor_timeout_s:
             est.advance(now)  # predict to the present, never further than a timeout
+        self._publish()
+
+    def _publish(self) -> None:
+        est = self.estimator
         stamp = s_to_stamp(est.t_s)
         self.odom_pub.publish(conv.odometry_msg(est.odometry(), stamp, 'odom', 'base_link'))
         self.traction_pub.publish(conv.traction_msg(est.traction(), stamp, Traction))
