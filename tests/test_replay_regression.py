@@ -113,6 +113,10 @@ def test_mode_manager_node_through_real_topics_makes_the_recorded_changes():
                               ['--ros-args', '-p', 'use_sim_time:=true'])
         player = None
         try:
+            # the probe must see the node's drive_mode publisher before any input is played
+            # (under use_sim_time the node decides nothing before the first /clock)
+            assert spin_until(executor, lambda: node.count_publishers('drive_mode') > 0, 30)
+            spin_until(executor, lambda: False, 0.5)
             player = NodeProcess('dukw_bringup', 'play', [
                 str(bag), '--clock', '--rate', '2',
                 '--topics', 'water/contact', 'depth', 'traction', 'tracks/status',

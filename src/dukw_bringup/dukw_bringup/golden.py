@@ -12,9 +12,10 @@ replay uses (``replay_adapters``), fed with the messages as decoded from their C
 bytes, on the nodes' timer grids with fixed offsets inside each step:
 
     T        sensor messages of the step (stamped T), authority, cmd_vel (+0.1/0.2 ms)
-    T+1 ms   ekf tick: odometry/filtered, traction
+    T+1 ms   ekf tick: odometry/filtered (the controller may step on it), traction (+1 us)
     T+2 ms   mode manager tick (every 5th step at 20 Hz): drive_mode on change or 1 s
-    T+3 ms   controller tick: tracks/cmd, props/cmd -> servo switch -> next physics step
+    T+3 ms   controller timer tick (if it steps): tracks/cmd, props/cmd -> servo switch;
+             the switch output drives the next physics step
 
 so replaying a golden bag reproduces its recorded outputs exactly (up to float noise).
 """
@@ -123,7 +124,7 @@ class _Loop:
                 if topic in adapter.inputs:
                     out = adapter.feed(topic, t_ns * 1e-9, decoded)
                     if out is not None and adapter is self.controller:
-                        self._command(t_ns, out)
+                        self._command(t_ns + 500, out)  # 0.5 us after its cause
 
     def _command(self, t_ns: int, out: dict[str, float]) -> None:
         from dukw_common.node_tools import s_to_stamp
@@ -181,10 +182,11 @@ class _Loop:
         if self.ekf.tick(t_ekf * 1e-9):
             est = self.ekf.core
             stamp = s_to_stamp(est.t_s)
+            # as ekf_node: odometry, then traction (1 us later, so the order is in the bag)
             self._emit('odometry/filtered', t_ekf,
                        odometry_msg(est.odometry(), stamp, 'odom', 'base_link'), everyone)
-            self._emit('traction', t_ekf, traction_msg(est.traction(), stamp, Traction),
-                       everyone)
+            self._emit('traction', t_ekf + 1_000,
+                       traction_msg(est.traction(), stamp, Traction), everyone)
         # mode manager (as mode_manager_node.on_timer)
         if k % self.mode_every == 0:
             t_mm = t_ns + 2 * MS_NS
@@ -198,9 +200,11 @@ class _Loop:
                 self.last_mode_ns = t_mm
                 self._emit('drive_mode', t_mm, decision_to_msg(decision, s_to_stamp(
                     t_mm * 1e-9)), everyone)
-        # controller
+        # controller timer (it may also have stepped on odometry above)
         t_ctrl = t_ns + 3 * MS_NS
-        self._command(t_ctrl, self.controller.tick(t_ctrl * 1e-9))
+        out = self.controller.tick(t_ctrl * 1e-9)
+        if out is not None:
+            self._command(t_ctrl, out)
 
     def run(self) -> None:
         steps = round(self.scenario.duration_s * 1e9 / self.step_ns)

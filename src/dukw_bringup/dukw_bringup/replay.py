@@ -49,8 +49,9 @@ class CoreAdapter(ABC):
         """
 
     @abstractmethod
-    def tick(self, t_s: float) -> dict[str, float]:
-        """Step the core at ``t_s``; return its output as named numbers."""
+    def tick(self, t_s: float) -> dict[str, float] | None:
+        """The node's timer at ``t_s``: step the core and return its output as named
+        numbers, or None when the node skips this tick (publishes nothing)."""
 
     @abstractmethod
     def recorded(self, topic: str, msg: Any) -> dict[str, float]:
@@ -121,8 +122,10 @@ class _Driver:
             return
         while self.next_tick_ns < t_ns or (inclusive and self.next_tick_ns == t_ns):
             t_s = self.next_tick_ns * 1e-9
-            self.latest = self.adapter.tick(t_s)
-            self.rows.append({'t_s': t_s, **self.latest})
+            out = self.adapter.tick(t_s)
+            if out is not None:
+                self.latest = out
+                self.rows.append({'t_s': t_s, **out})
             self.next_tick_ns += self.period_ns
 
     def feed(self, topic: str, t_ns: int, msg: Any) -> None:

@@ -91,7 +91,12 @@ class ModeManagerAdapter(CoreAdapter):
 
 
 class DriveControllerAdapter(CoreAdapter):
-    """dukw_control.controller.DriveController as drive_controller_node drives it."""
+    """dukw_control.controller.DriveController as drive_controller_node drives it.
+
+    With ``step_on_odometry`` the node steps on every odometry/filtered message and its
+    timer steps only while the estimator is silent (1.5 periods); pitch then comes from
+    the odometry orientation (older nodes: a step per timer tick, pitch from imu/data).
+    """
 
     name = 'drive_controller'
     inputs = ('cmd_vel', 'authority', 'drive_mode', 'odometry/filtered', 'imu/data',
@@ -105,6 +110,9 @@ class DriveControllerAdapter(CoreAdapter):
         self.rate_hz = float(params['rate_hz'])
         self.core = DriveController(settings_from_params(params))
         self.convert = convert
+        self.step_on_odometry = bool(params.get('step_on_odometry', False))
+        self.pitch_from_odometry = hasattr(convert, 'pitch_from_quaternion')
+        self.last_event_step_s = -1.0
 
     def feed(self, topic, t_s, msg):
         core = self.core
@@ -114,12 +122,18 @@ class DriveControllerAdapter(CoreAdapter):
             usable, detail = self.convert.authority_usable(msg)
             core.on_authority(usable, detail, t_s)
             if not usable:
-                return self.tick(t_s)  # the node goes neutral at once
+                return self._step(t_s)  # the node goes neutral at once
         elif topic == 'drive_mode':
             core.on_mode(self.convert.decision_from_msg(msg))
         elif topic == 'odometry/filtered':
             core.on_odometry(msg.twist.twist.linear.x, msg.twist.twist.angular.z, t_s)
-        elif topic == 'imu/data':
+            if self.pitch_from_odometry:
+                core.on_pitch(self.convert.pitch_from_quaternion(msg.pose.pose.orientation),
+                              t_s)
+            if self.step_on_odometry:
+                self.last_event_step_s = t_s
+                return self._step(t_s)
+        elif topic == 'imu/data' and not self.pitch_from_odometry:
             core.on_pitch(self.convert.pitch_from_imu(msg), t_s)
         elif topic == 'traction':
             core.on_slips(msg.port_slip, msg.stbd_slip, t_s)
@@ -127,10 +141,15 @@ class DriveControllerAdapter(CoreAdapter):
             core.on_track_currents(msg.port.current_a, msg.stbd.current_a, t_s)
         return None
 
-    def tick(self, t_s):
+    def _step(self, t_s: float) -> dict[str, float]:
         out = self.core.step(t_s)
         return {**_side_row('tracks', out.tracks.port, out.tracks.stbd),
                 **_side_row('props', out.props.port, out.props.stbd)}
+
+    def tick(self, t_s):
+        if self.step_on_odometry and t_s - self.last_event_step_s < 1.5 / self.rate_hz:
+            return None              # stepped on odometry: the timer only guards silence
+        return self._step(t_s)
 
     def recorded(self, topic, msg):
         return _side_row(topic.split('/')[0], msg.port_pct, msg.stbd_pct)
