@@ -12,7 +12,9 @@ replay uses (``replay_adapters``), fed with the messages as decoded from their C
 bytes, on the nodes' timer grids with fixed offsets inside each step:
 
     T        sensor messages of the step (stamped T), authority, cmd_vel (+0.1/0.2 ms)
-    T+1 ms   ekf tick: odometry/filtered (the controller may step on it), traction (+1 us)
+    T+0.5 ms the EKF's output on the IMU sample: odometry/filtered (the controller steps
+             on it: tracks/cmd, props/cmd at +0.5 us), traction (+1 us)
+    T+1 ms   ekf timer tick (publishes only while the IMU is silent)
     T+2 ms   mode manager tick (every 5th step at 20 Hz): drive_mode on change or 1 s
     T+3 ms   controller timer tick (if it steps): tracks/cmd, props/cmd -> servo switch;
              the switch output drives the next physics step
@@ -106,6 +108,7 @@ class _Loop:
                 raise ValueError(f'golden: {name} rate {rate} Hz must equal the sim step')
         self.mode_every = round(1e9 / self.modes.rate_hz) // self.step_ns
         self.last_authority_ns: int | None = None
+        self.ekf_pending: tuple | None = None
         self.timeline: list[tuple[float, str]] = []
 
     # --- messages ------------------------------------------------------------------
@@ -119,12 +122,15 @@ class _Loop:
         raw = self.store.serialize_cdr(decoded, msgtype)
         self.writer.add_topic('/' + topic, msgtype)
         self.writer.write('/' + topic, t_ns, raw)
-        if consumers:
-            for adapter in consumers:
-                if topic in adapter.inputs:
-                    out = adapter.feed(topic, t_ns * 1e-9, decoded)
-                    if out is not None and adapter is self.controller:
-                        self._command(t_ns + 500, out)  # 0.5 us after its cause
+        for adapter in consumers:
+            if topic in adapter.inputs:
+                out = adapter.feed(topic, t_ns * 1e-9, decoded)
+                if out is not None and adapter is self.controller:
+                    self._command(t_ns + 500, out)  # 0.5 us after its cause
+                elif out is not None and adapter is self.ekf:
+                    # built now (what the EKF knows after this IMU sample), written after
+                    # this step's other sensor messages
+                    self.ekf_pending = self._estimate_messages()
 
     def _command(self, t_ns: int, out: dict[str, float]) -> None:
         from dukw_common.node_tools import s_to_stamp
@@ -136,12 +142,26 @@ class _Loop:
             self._emit(f'{actuator}/cmd', t_ns, diff_command(SidePair(port, stbd), stamp))
             self.switch.command(actuator, port, stbd, t_ns * 1e-9)
 
+    def _estimate_messages(self) -> tuple:
+        """odometry/filtered and traction as ekf_node would publish them now."""
+        from dukw_common.node_tools import s_to_stamp
+        from dukw_estimation.ros_convert import odometry_msg, traction_msg
+        from dukw_msgs.msg import Traction
+        est = self.ekf.core
+        stamp = s_to_stamp(est.t_s)
+        return (odometry_msg(est.odometry(), stamp, 'odom', 'base_link'),
+                traction_msg(est.traction(), stamp, Traction))
+
+    def _publish_estimates(self, t_ns: int, messages: tuple) -> None:
+        """As ekf_node: odometry, then traction (1 us later, so the order is in the bag)."""
+        everyone = (self.ekf, self.modes, self.controller)
+        self._emit('odometry/filtered', t_ns, messages[0], everyone)
+        self._emit('traction', t_ns + 1_000, messages[1], everyone)
+
     # --- one step --------------------------------------------------------------------
     def step(self, k: int) -> None:
         from dukw_common.node_tools import s_to_stamp
         from dukw_control.convert import decision_to_msg
-        from dukw_estimation.ros_convert import odometry_msg, traction_msg
-        from dukw_msgs.msg import Traction
         from dukw_sim import sim_messages as sm
         from dukw_sim.core import Actuation
         from dukw_sim.sensors import (DepthReading, DrivetrainReading, GpsFix, GpsVelocity,
@@ -177,16 +197,13 @@ class _Loop:
             twist = Twist()
             twist.linear.x, twist.angular.z = float(speed), float(yaw_rate)
             self._emit('cmd_vel', t_ns + MS_NS // 5, twist, everyone)
-        # ekf
+        if self.ekf_pending is not None:           # the EKF published on the IMU sample
+            self._publish_estimates(t_ns + MS_NS // 2, self.ekf_pending)
+            self.ekf_pending = None
+        # ekf timer (publishes only while the IMU is silent)
         t_ekf = t_ns + MS_NS
-        if self.ekf.tick(t_ekf * 1e-9):
-            est = self.ekf.core
-            stamp = s_to_stamp(est.t_s)
-            # as ekf_node: odometry, then traction (1 us later, so the order is in the bag)
-            self._emit('odometry/filtered', t_ekf,
-                       odometry_msg(est.odometry(), stamp, 'odom', 'base_link'), everyone)
-            self._emit('traction', t_ekf + 1_000,
-                       traction_msg(est.traction(), stamp, Traction), everyone)
+        if self.ekf.tick(t_ekf * 1e-9) is not None:
+            self._publish_estimates(t_ekf, self._estimate_messages())
         # mode manager (as mode_manager_node.on_timer)
         if k % self.mode_every == 0:
             t_mm = t_ns + 2 * MS_NS

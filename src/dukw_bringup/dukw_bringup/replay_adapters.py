@@ -156,7 +156,8 @@ class DriveControllerAdapter(CoreAdapter):
 
 
 class EkfAdapter(CoreAdapter):
-    """dukw_estimation.estimator.Estimator as ekf_node drives it."""
+    """dukw_estimation.estimator.Estimator as ekf_node drives it: with ``publish_on_imu``
+    it publishes after each IMU sample and its timer only while the IMU is silent."""
 
     name = 'ekf'
     inputs = ('imu/data', 'gps/fix', 'gps/vel', 'water/contact', 'depth', 'tracks/status',
@@ -190,18 +191,28 @@ class EkfAdapter(CoreAdapter):
             'tracks/status': (c.drive_status, self.core.add_tracks),
             'props/status': (c.drive_status, self.core.add_props)}
         self.stamp_or = c.stamp_or
+        self.publish_on_imu = bool(params.get('publish_on_imu', False))
+        self.last_event_publish_s = -1.0
 
     def feed(self, topic, t_s, msg):
         convert, add = self.routes[topic]
         add(convert(msg, self.stamp_or(msg, t_s)))
+        if topic == 'imu/data' and self.publish_on_imu and self.core.t_s is not None:
+            self.last_event_publish_s = t_s
+            return self.output()     # the node publishes on each IMU sample
         return None
 
     def tick(self, t_s):
         est = self.core
-        if est.t_s is None:
-            return {}
+        if est.t_s is None or t_s - self.last_event_publish_s < 1.5 / self.rate_hz:
+            return None              # nothing measured yet, or the IMU drives the output
         if 0.0 < t_s - est.t_s <= self.settings.sensor_timeout_s:
             est.advance(t_s)
+        return self.output()
+
+    def output(self) -> dict[str, float]:
+        """The estimates the node would publish now."""
+        est = self.core
         odom = est.odometry()
         row = {'odom.x_m': float(odom.x_m), 'odom.y_m': float(odom.y_m),
                'odom.yaw_rad': float(odom.yaw_rad), 'odom.surge_mps': float(odom.surge_mps),
