@@ -12,6 +12,9 @@ SUBMERSION = ('volume_error_pct', 'fraction_error')
 #: tracks touch is only seen through the two wet/dry sensors, and the volume error can exceed
 #: 10 % of the displacement volume. Checked, and reported as xfail when it does.
 ROUGH_SEA = {s.name for s in evaluate.scenarios() if s.wave_height_m > 0.2}
+#: What the estimator achieves there today (worst of the four runs: 20.5 %, 0.12): a run
+#: beyond these has regressed and fails outright, the target gap alone is the xfail.
+ROUGH_SEA_BOUNDS = {'volume_error_pct': 25.0, 'fraction_error': 0.15}
 
 
 @pytest.mark.slow
@@ -23,6 +26,8 @@ def test_scenario_meets_the_accuracy_targets(scenario):
     assert sum(result['rejected'].values()) <= 20, result       # a clean run, few outliers
     missed = {k: result[k] for k in SUBMERSION if result[k] > evaluate.TARGETS[k]}
     if missed and scenario.name in ROUGH_SEA:
+        worse = {k: v for k, v in missed.items() if v > ROUGH_SEA_BOUNDS[k]}
+        assert not worse, f'28 cm sea: worse than the known gap: {worse}'
         pytest.xfail(f'known gap in the 28 cm sea: {missed}')
     assert not missed, result
 
