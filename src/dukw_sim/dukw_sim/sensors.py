@@ -26,7 +26,7 @@ from dukw_common.config import ConfigError, ParamValue, build_settings, node_par
 from dukw_common.geometry import geodetic_from_local_enu, quaternion_from_euler
 from dukw_common.vehicle import (DrivetrainParams, SensorMounts, drivetrain_params,
                                   sensor_mounts)
-from dukw_driver.motors import prop_thrust_n
+from dukw_driver.motors import SideStatus, prop_thrust_n
 from dukw_sim.truth import Truth
 
 NODE_NAME = 'sim_node'
@@ -92,27 +92,14 @@ class DepthReading:
 
 
 @dataclass(frozen=True)
-class MotorReading:
-    """One motor channel as its controller reports it (dukw_msgs/MotorSide)."""
-
-    command_pct: float
-    current_a: float
-    voltage_v: float
-    speed_mps: float
-    force_n: float
-    temperature_c: float
-    fault_flags: Fault
-
-
-@dataclass(frozen=True)
 class DrivetrainReading:
     """A dual-channel motor controller: tracks or propellers."""
 
     t_s: float
     drive: str                     # 'tracks' | 'props'
     connected: bool
-    port: MotorReading
-    stbd: MotorReading
+    port: SideStatus               # one motor channel, as the real driver reports it
+    stbd: SideStatus
 
 
 class Fault(IntFlag):
@@ -121,6 +108,10 @@ class Fault(IntFlag):
     OVERHEAT = 1
     UNDERVOLTAGE = 4
     STALL = 256
+
+    def names(self) -> tuple[str, ...]:
+        """Names of the raised bits, as dukw_msgs/MotorSide.faults lists them."""
+        return tuple(f.name.lower() for f in Fault if f in self)
 
 
 # ----------------------------------------------------------------------------- settings
@@ -573,7 +564,8 @@ class SensorModel:
             flags = self._motors[drive, side].update(dt, currents[i], stalling, voltage, under_v)
             current = currents[i] + noise.current_std_a * d[3 * i]
             speed = 0.0 if speeds is None else true_speed + noise.speed_std_mps * d[3 * i + 1]
-            sides.append(MotorReading(
+            sides.append(SideStatus(
                 commands[i], current, voltage + noise.voltage_std_v * d[3 * i + 2], speed,
-                force_n(current, commands[i]), self._motors[drive, side].temperature_c, flags))
+                force_n(current, commands[i]), self._motors[drive, side].temperature_c,
+                int(flags), flags.names()))
         return DrivetrainReading(truth.t_s, drive, True, sides[0], sides[1])

@@ -20,8 +20,9 @@ from sensor_msgs.msg import Imu, NavSatFix, NavSatStatus
 
 from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS
 from dukw_driver.authority import AuthorityState
-from dukw_sim.sensors import (DepthReading, DrivetrainReading, Fault, GpsFix, GpsVelocity,
-                              ImuReading, MotorReading, WaterContactReading)
+from dukw_driver.motors import SideStatus
+from dukw_sim.sensors import (DepthReading, DrivetrainReading, GpsFix, GpsVelocity,
+                              ImuReading, WaterContactReading)
 from dukw_sim.switch import RcReading
 from dukw_sim.truth import Truth
 
@@ -35,7 +36,6 @@ TOPICS = [('imu/data', Imu, SENSOR_QOS), ('gps/fix', NavSatFix, SENSOR_QOS),
           ('/clock', Clock, COMMAND_QOS), ('/diagnostics', DiagnosticArray, COMMAND_QOS)]
 #: A variance that says "not measured" in a covariance the message must fill.
 UNMEASURED_VAR = 1e6
-_FAULT_NAMES = [(int(flag), name.lower()) for name, flag in Fault.__members__.items()]
 #: SimTruth fields copied from Truth fields of the same name.
 _TRUTH_FIELDS = [f for f in SimTruth.get_fields_and_field_types()
                  if f not in ('header', 'medium') and f in Truth.__dataclass_fields__]
@@ -65,13 +65,10 @@ def _diag3(var: tuple) -> list[float]:
     return [var[0], 0.0, 0.0, 0.0, var[1], 0.0, 0.0, 0.0, var[2]]
 
 
-def _fill_side(side: MotorSide, m: MotorReading) -> None:
-    flags = int(m.fault_flags)
+def _fill_side(side: MotorSide, m: SideStatus) -> None:
     side.command_pct, side.current_a, side.voltage_v = m.command_pct, m.current_a, m.voltage_v
     side.speed_mps, side.force_n, side.temperature_c = m.speed_mps, m.force_n, m.temperature_c
-    if flags != side.fault_flags or (flags and not side.faults):
-        side.fault_flags = flags
-        side.faults = [name for bit, name in _FAULT_NAMES if flags & bit]
+    side.fault_flags, side.faults = m.fault_flags, list(m.faults)
 
 
 class SimMessages:

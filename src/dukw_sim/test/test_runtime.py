@@ -6,9 +6,10 @@ from dukw_msgs.msg import Authority, DrivetrainStatus, MotorSide, SimTruth
 
 from dukw_common.diagnostics import Level
 from dukw_driver.authority import AuthorityState, Holder, Reason
+from dukw_driver.motors import SideStatus
 from dukw_sim.runtime import Pacer, SpeedMeter, sim_healths
 from dukw_sim.sensors import (DepthReading, DrivetrainReading, Fault, GpsFix, GpsVelocity,
-                              ImuReading, MotorReading, WaterContactReading)
+                              ImuReading, WaterContactReading)
 from dukw_sim.sim_messages import TOPICS, Frames, SimMessages
 from dukw_sim.switch import RcReading
 from dukw_sim.truth import Medium, Truth
@@ -117,8 +118,9 @@ def test_readings_become_messages_on_their_topics():
 
 def test_drivetrain_faults_are_decoded_to_names():
     msgs = SimMessages(FRAMES)
-    side = MotorReading(100.0, 60.0, 23.0, 0.0, 489.6, 80.0, Fault.STALL | Fault.OVERHEAT)
-    ok = MotorReading(50.0, 10.0, 24.0, 1.0, 81.6, 30.0, Fault(0))
+    flags = Fault.STALL | Fault.OVERHEAT
+    side = SideStatus(100.0, 60.0, 23.0, 0.0, 489.6, 80.0, int(flags), flags.names())
+    ok = SideStatus(50.0, 10.0, 24.0, 1.0, 81.6, 30.0, 0, Fault(0).names())
     topic, msg = msgs.reading(DrivetrainReading(3.0, 'tracks', True, side, ok))
     assert topic == 'tracks/status' and msg.drive == DrivetrainStatus.DRIVE_TRACKS
     assert msg.port.fault_flags == MotorSide.FAULT_STALL | MotorSide.FAULT_OVERHEAT
