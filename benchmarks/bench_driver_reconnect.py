@@ -76,18 +76,34 @@ def main() -> None:
                      lambda m: m.connected, r_dev)):
                 node = cls(context=probe.context,
                            parameter_overrides=parameter_overrides({'port': str(port)}))
-                executor.add_node(node)
-                flag = Flag(match)
-                probe.create_subscription(msg_type, topic, flag.on_message, SENSOR_QOS)
-                spin_until(executor, flag, 10.0)
-                cases.append((node.get_name(), measure(executor, device, flag, args.repeat,
-                                                       args.down_s)))
-                executor.remove_node(node)
-                node.destroy_node()
+                cases.append(run_case(probe, executor, node, (msg_type, topic, match),
+                                      device, args))
+    report(cases, args.repeat)
+
+
+def run_case(probe, executor, node, stream, device, args) -> tuple[str, list[float]]:
+    """Measure one node's replug-to-publishing times; ``stream`` = (type, topic, match)."""
+    msg_type, topic, match = stream
+    name = node.get_name()
+    executor.add_node(node)
+    flag = Flag(match)
+    probe.create_subscription(msg_type, topic, flag.on_message, SENSOR_QOS)
+    spin_until(executor, flag, 10.0)
+    figures = measure(executor, device, flag, args.repeat, args.down_s)
+    executor.remove_node(node)
+    shutdown = getattr(node, 'on_shutdown', None)
+    if callable(shutdown):
+        shutdown()
+    node.destroy_node()
+    return name, figures
+
+
+def report(cases: list[tuple[str, list[float]]], repeat: int) -> None:
+    """Print median and max replug-to-publishing time per node."""
     for name, figures in cases:
         if figures:
             print(f'{name}: replug -> publishing again: median {statistics.median(figures):.2f} s,'
-                  f' max {max(figures):.2f} s over {len(figures)} of {args.repeat} replugs '
+                  f' max {max(figures):.2f} s over {len(figures)} of {repeat} replugs '
                   f'(issue 4: < 2 s)')
         else:
             print(f'{name}: never published again within 10 s')

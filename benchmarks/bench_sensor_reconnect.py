@@ -9,7 +9,6 @@ measuring loop is bench_driver_reconnect's.
 from __future__ import annotations
 
 import argparse
-import statistics
 import sys
 import tempfile
 from pathlib import Path
@@ -17,13 +16,13 @@ from pathlib import Path
 from dukw_msgs.msg import WaterContact
 from sensor_msgs.msg import Imu
 
-from dukw_common.node_tools import SENSOR_QOS, parameter_overrides
-from dukw_common.testing import ros_node, spin_until
+from dukw_common.node_tools import parameter_overrides
+from dukw_common.testing import ros_node
 from dukw_driver.imu_gps_node import ImuGpsNode
 from dukw_driver.water_sensor_node import WaterSensorNode
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / 'src' / 'dukw_driver' / 'test'))
-from bench_driver_reconnect import Flag, measure  # noqa: E402
+from bench_driver_reconnect import report, run_case  # noqa: E402
 from fake_device import FakeDevice  # noqa: E402
 from test_imu_gps_node import FakeImu, dgps_stream  # noqa: E402
 from test_water_sensor_node import FakeNumato, FakeSounder  # noqa: E402
@@ -51,22 +50,9 @@ def main() -> None:
                      WaterContact, 'water/contact', adc)):
                 node = cls(context=probe.context, parameter_overrides=parameter_overrides(
                     {k: str(v) for k, v in ports.items()}))
-                executor.add_node(node)
-                flag = Flag(lambda _msg: True)
-                probe.create_subscription(msg_type, topic, flag.on_message, SENSOR_QOS)
-                spin_until(executor, flag, 10.0)
-                results.append((node.get_name(), measure(executor, device, flag, args.repeat,
-                                                         args.down_s)))
-                executor.remove_node(node)
-                node.on_shutdown()
-                node.destroy_node()
-    for name, figures in results:
-        if figures:
-            print(f'{name}: replug -> publishing again: median {statistics.median(figures):.2f} s,'
-                  f' max {max(figures):.2f} s over {len(figures)} of {args.repeat} replugs '
-                  f'(issue 4: < 2 s)')
-        else:
-            print(f'{name}: never published again within 10 s')
+                results.append(run_case(probe, executor, node,
+                                        (msg_type, topic, lambda _msg: True), device, args))
+    report(results, args.repeat)
 
 
 if __name__ == '__main__':
