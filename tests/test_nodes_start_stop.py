@@ -15,7 +15,7 @@ def test_node_starts_and_stops_cleanly(package, name):
     with ros_node(f'probe_{name}') as (probe, executor):
         proc = NodeProcess(package, name)
         try:
-            seen = spin_until(executor, lambda: name in probe.get_node_names(), timeout_s=20)
+            seen = spin_until(executor, lambda: name in probe.get_node_names(), timeout_s=60)
             alive = proc.alive()
         finally:
             code = proc.stop()
