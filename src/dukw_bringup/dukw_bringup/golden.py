@@ -164,8 +164,6 @@ class _Loop:
         from dukw_control.convert import decision_to_msg
         from dukw_sim import sim_messages as sm
         from dukw_sim.core import Actuation
-        from dukw_sim.sensors import (DepthReading, DrivetrainReading, GpsFix, GpsVelocity,
-                                      ImuReading, WaterContactReading)
         from geometry_msgs.msg import Twist
 
         t_prev_s = self.sim.t_s
@@ -174,23 +172,15 @@ class _Loop:
                                         out.props.port_pct, out.props.stbd_pct))
         t_ns = k * self.step_ns
         everyone = (self.ekf, self.modes, self.controller)
-        builders = {ImuReading: ('imu/data', sm.imu), GpsFix: ('gps/fix', sm.gps_fix),
-                    GpsVelocity: ('gps/vel', sm.gps_velocity),
-                    WaterContactReading: ('water/contact', sm.water_contact),
-                    DepthReading: ('depth', sm.depth)}
         for reading in self.sensors.sample(truth):
-            if isinstance(reading, DrivetrainReading):
-                topic, msg = f'{reading.drive}/status', sm.drivetrain(reading, self.frames)
-            else:
-                topic, build = builders[type(reading)]
-                msg = build(reading, self.frames)
+            topic, msg = sm.fresh_reading(reading, self.frames)
             self._emit(topic, t_ns, msg, everyone)
         state = self.switch.state
         if (self.switch.gate.changed or self.last_authority_ns is None
                 or t_ns - self.last_authority_ns >= 1_000 * MS_NS):
             self.switch.gate.changed = False
             self.last_authority_ns = t_ns
-            self._emit('authority', t_ns + MS_NS // 10, sm.authority(state, truth.t_s),
+            self._emit('authority', t_ns + MS_NS // 10, sm.fresh_authority(state, truth.t_s),
                        everyone)
         if k % 10 == 0:
             speed, yaw_rate = self.scenario.cmd_vel(t_ns * 1e-9)

@@ -211,36 +211,11 @@ class SimMessages:
 
 # One-off builders returning a fresh message each call (offline tools, e.g. golden bags);
 # sim_node uses a SimMessages instance, which updates one message per topic in place.
-def imu(r: ImuReading, frames: Frames) -> Imu:
-    """A fresh sensor_msgs/Imu."""
-    return SimMessages(frames).imu(r)
+def fresh_reading(r, frames: Frames) -> tuple[str, object]:
+    """(topic, a fresh message) for any reading SensorModel.sample gives."""
+    return SimMessages(frames).reading(r)
 
 
-def gps_fix(r: GpsFix, frames: Frames) -> NavSatFix:
-    """A fresh sensor_msgs/NavSatFix."""
-    return SimMessages(frames).gps_fix(r)
-
-
-def gps_velocity(r: GpsVelocity, frames: Frames) -> TwistWithCovarianceStamped:
-    """A fresh geometry_msgs/TwistWithCovarianceStamped."""
-    return SimMessages(frames).gps_velocity(r)
-
-
-def water_contact(r: WaterContactReading, frames: Frames) -> WaterContact:
-    """A fresh dukw_msgs/WaterContact."""
-    return SimMessages(frames).water_contact(r)
-
-
-def depth(r: DepthReading, frames: Frames) -> Depth:
-    """A fresh dukw_msgs/Depth."""
-    return SimMessages(frames).depth(r)
-
-
-def drivetrain(r: DrivetrainReading, frames: Frames) -> DrivetrainStatus:
-    """A fresh dukw_msgs/DrivetrainStatus."""
-    return SimMessages(frames).drivetrain(r)
-
-
-def authority(state: AuthorityState, t_s: float) -> Authority:
+def fresh_authority(state: AuthorityState, t_s: float) -> Authority:
     """A fresh dukw_msgs/Authority."""
     return SimMessages(Frames('', '', '')).authority(state, t_s)

@@ -160,11 +160,12 @@ def test_rc_authority_and_clock_messages():
 
 def test_one_off_builders_return_fresh_messages():
     from dukw_sim import sim_messages as sm
-    a = sm.depth(DepthReading(1.0, True, 1.5, 0.0, 18.0), FRAMES)
-    b = sm.depth(DepthReading(2.0, True, 2.5, 0.0, 18.0), FRAMES)
+    topic, a = sm.fresh_reading(DepthReading(1.0, True, 1.5, 0.0, 18.0), FRAMES)
+    _, b = sm.fresh_reading(DepthReading(2.0, True, 2.5, 0.0, 18.0), FRAMES)
+    assert topic == 'depth'
     assert (a.depth_m, b.depth_m) == (1.5, 2.5) and a.header.frame_id == 'base_link'
     state = AuthorityState(Holder.COMPUTER, Reason.RC_SWITCH, True, False, 'computer')
-    assert sm.authority(state, 1.0).holder == Authority.HOLDER_COMPUTER
+    assert sm.fresh_authority(state, 1.0).holder == Authority.HOLDER_COMPUTER
 
 
 def test_sim_node_declares_every_key_of_its_config_block_own_ones_with_ranges():
