@@ -10,6 +10,7 @@ two agree (tested). Vectorised over arrays of h2.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -67,6 +68,86 @@ def segment_area_m2(depth_m: ArrayLike, radius_m: float) -> ArrayLike:
     h = r - d
     out = r * r * np.arccos(np.clip(h / r, -1.0, 1.0)) - h * np.sqrt(np.maximum(r * r - h * h, 0))
     return float(out) if out.ndim == 0 else out
+
+
+def segment_area_integral_m3_per_m(depth_m: float, radius_m: float) -> float:
+    """Integral of the segment area over water depth, int_0^d A(u) du, m^3/m (exact).
+
+    A hull bottom line dipping by g per metre holds F(d2)/g - F(d1)/g between the depths d1
+    and d2 at its ends. Beyond 2r the whole circle adds pi r^2 per metre of depth.
+    """
+    r = radius_m
+    d = max(depth_m, 0.0)
+    full = 2.0 * r
+
+    def antiderivative(v: float) -> float:        # of A in v = r - u, A(v) = r^2 acos(v/r)
+        root = math.sqrt(max(r * r - v * v, 0.0))   # - v sqrt(r^2 - v^2)
+        return r * r * (v * math.acos(max(-1.0, min(1.0, v / r))) - root) + root ** 3 / 3.0
+    inside = min(d, full)
+    return -antiderivative(r - inside) + math.pi * r * r * max(d - full, 0.0)
+
+
+def cylinder_float_depth_m(displaced_volume_m3: float, radius_m: float,
+                           length_m: float) -> float:
+    """Water over the bottoms of two level cylinders that displace the volume given, m."""
+    target = displaced_volume_m3 / (2.0 * length_m)
+    if target >= math.pi * radius_m ** 2:
+        raise ValueError('the hulls cannot carry the displacement (hull_radius_m too small)')
+    lo, hi = 0.0, 2.0 * radius_m
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if float(segment_area_m2(mid, radius_m)) < target:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+@dataclass(frozen=True)
+class HullSection:
+    """Cross-section of each SWATH hull: the paper's cylinder up to the float line, then
+    wall-sided (the strut) with the waterplane area of vehicle.md section 1 above it.
+
+    The cylinders alone are almost wholly immersed afloat (0.288 of 0.313 m^3), so a crest
+    over the float line meets the strut. The simulator's strips and the estimator's
+    submersion both use this section.
+    """
+
+    radius_m: float
+    float_depth_m: float         # water over the hull bottom afloat in calm water
+    strut_width_m: float         # wall-sided width above the float line
+
+    @classmethod
+    def of_hulls(cls, displaced_volume_m3: float, radius_m: float, length_m: float,
+                 waterplane_area_m2: float) -> 'HullSection':
+        """Float line from the displacement, strut width from the waterplane of two hulls."""
+        return cls(radius_m, cylinder_float_depth_m(displaced_volume_m3, radius_m, length_m),
+                   waterplane_area_m2 / (2.0 * length_m))
+
+    def area_m2(self, depth_m: ArrayLike) -> ArrayLike:
+        """Immersed section from the water height over the hull bottom, m^2 (vectorised)."""
+        d = np.asarray(depth_m, dtype=float)
+        out = segment_area_m2(np.minimum(d, self.float_depth_m), self.radius_m) \
+            + self.strut_width_m * np.maximum(d - self.float_depth_m, 0.0)
+        return float(out) if np.ndim(out) == 0 else out
+
+    def area_integral_m3_per_m(self, depth_m: float) -> float:
+        """int_0^d area(u) du, m^3/m: the volume of a hull dipping 1 m per metre to depth d."""
+        f = self.float_depth_m
+        above = max(depth_m - f, 0.0)
+        return segment_area_integral_m3_per_m(min(depth_m, f), self.radius_m) \
+            + float(segment_area_m2(f, self.radius_m)) * above \
+            + 0.5 * self.strut_width_m * above * above
+
+    def line_volume_m3(self, depth0_m: float, gradient: float, bow_x_m: float,
+                       stern_x_m: float) -> float:
+        """ONE hull from stern_x to bow_x whose bottom line has depth0 + gradient x of water
+        over it (body x), m^3, exact."""
+        if abs(gradient) < 1e-9:
+            return float(self.area_m2(depth0_m)) * (bow_x_m - stern_x_m)
+        ends = (depth0_m + gradient * bow_x_m, depth0_m + gradient * stern_x_m)
+        return abs(self.area_integral_m3_per_m(ends[0])
+                   - self.area_integral_m3_per_m(ends[1])) / abs(gradient)
 
 
 def hull_volume_from_depths(depths_m: np.ndarray, radius_m: float, length_m: float) -> float:
@@ -131,25 +212,21 @@ def _bottom_depth_line(waterline_distance_m: float, slope_rad: float, hull_clear
 
 def grounded_volume_m3(waterline_distance_m: float, slope_rad: float, hull_clearance_m: float,
                        bow_x_m: float, stern_x_m: float, radius_m: float,
-                       surface_m: float = 0.0, heading_cos: float = 1.0) -> float:
+                       surface_m: float = 0.0, heading_cos: float = 1.0,
+                       section: HullSection | None = None) -> float:
     """Submerged volume of BOTH hulls of a vehicle standing on the slope, m^3.
 
-    Each hull is a cylinder of ``radius_m`` from ``stern_x_m`` to ``bow_x_m`` (vehicle.md
-    section 6): the paper's wedge volume for the deep end minus the one beyond the shallow
-    end, so a hull wholly under water with its shallow end wet is exact too. Not capped at
-    the displacement: compare with ``afloat_volume_m3`` to know whether the vehicle floats.
+    Each hull runs from ``stern_x_m`` to ``bow_x_m``; its cross-section is ``section``
+    (default: the paper's bare cylinder of ``radius_m``, vehicle.md section 6). Exact for the
+    straight bottom line: the section's area integrated between the depths at the ends. Not
+    capped at the displacement: compare with ``afloat_volume_m3`` to know whether the
+    vehicle floats.
     """
     depth0, gradient = _bottom_depth_line(waterline_distance_m, slope_rad, hull_clearance_m,
                                           surface_m, heading_cos)
-    length = bow_x_m - stern_x_m
-    if abs(gradient) < 1e-6:
-        return 2.0 * float(segment_area_m2(depth0, radius_m)) * length
-    deep_x, shallow_x = (bow_x_m, stern_x_m) if gradient > 0.0 else (stern_x_m, bow_x_m)
-    g = abs(gradient)
-    one = _wedge_volume(depth0 + gradient * deep_x, g, radius_m) \
-        - _wedge_volume(depth0 + gradient * shallow_x, g, radius_m)
-    return 2.0 * one
-
+    if section is None:
+        section = HullSection(radius_m, 2.0 * radius_m, 0.0)
+    return 2.0 * section.line_volume_m3(depth0, gradient, bow_x_m, stern_x_m)
 
 
 def heave_mass_kg(waterplane_area_m2: float, water_density_kgpm3: float, gravity_mps2: float,

@@ -43,6 +43,8 @@ class Estimator:
         # simulator's hull strips; inside bow_x_m .. stern_x_m of the overall length
         self.hull_bow_x_m = min(0.5 * body.hull_length_m, body.bow_x_m)
         self.hull_stern_x_m = max(-0.5 * body.hull_length_m, body.stern_x_m)
+        self.section = buoyancy.HullSection.of_hulls(body.displaced_volume_m3, body.hull_radius_m,
+                                                     body.hull_length_m, body.waterplane_area_m2)
         self.track_area_m2 = body.track_width_m * body.track_contact_length_m
         self.heave_mass_kg = buoyancy.heave_mass_kg(body.waterplane_area_m2,
                                                     body.water_density_kgpm3,
@@ -426,7 +428,8 @@ class Estimator:
         heading_cos = math.cos(x[Idx.YAW] - self.settings.seaward_yaw_rad)
         args = (x[Idx.S], slope, body.hull_clearance_m, self.hull_bow_x_m, self.hull_stern_x_m)
         h2 = buoyancy.submerged_length_m(*args, x[Idx.ETA], heading_cos)
-        volume = buoyancy.grounded_volume_m3(*args, body.hull_radius_m, x[Idx.ETA], heading_cos)
+        volume = buoyancy.grounded_volume_m3(*args, body.hull_radius_m, x[Idx.ETA], heading_cos,
+                                             self.section)
         afloat = self.afloat = self._floating(volume)
         if afloat:
             volume = self._afloat_volume()

@@ -69,3 +69,40 @@ def test_slope_must_be_positive():
 
 def test_afloat_volume_is_the_displacement():
     assert buoyancy.afloat_volume_m3(2894.0, 1025.0, 9.81) == pytest.approx(0.2878, abs=1e-4)
+
+
+SECTION = buoyancy.HullSection.of_hulls(0.2878, R, 2.54, 0.89)
+
+
+@pytest.mark.parametrize('depth', [0.0, 0.03, 0.14, 0.2, 0.28, 0.5])
+def test_segment_area_integral_matches_quadrature(depth):
+    expected = quad(lambda u: float(buoyancy.segment_area_m2(u, R)), 0.0, depth,
+                    epsabs=1e-15, epsrel=1e-12)[0]
+    assert buoyancy.segment_area_integral_m3_per_m(depth, R) == pytest.approx(
+        expected, rel=1e-9, abs=1e-15)
+
+
+def test_hull_section_floats_the_displacement_and_goes_wall_sided_above():
+    two_hulls = 2 * SECTION.area_m2(SECTION.float_depth_m) * 2.54
+    assert two_hulls == pytest.approx(0.2878, rel=1e-9)
+    above = SECTION.area_m2(SECTION.float_depth_m + 0.1) - SECTION.area_m2(SECTION.float_depth_m)
+    assert above == pytest.approx(0.1 * 0.89 / (2 * 2.54), rel=1e-9)   # the strut's waterplane
+    assert SECTION.area_m2(-0.1) == 0.0
+
+
+@pytest.mark.parametrize('depth0, gradient', [(0.2, 0.05), (0.3, -0.1), (0.45, 0.0),
+                                              (0.1, 0.3), (-0.05, 0.08), (0.6, -0.02)])
+def test_line_volume_is_the_section_integrated_along_the_hull(depth0, gradient):
+    expected = quad(lambda x: float(SECTION.area_m2(depth0 + gradient * x)), -1.27, 1.27,
+                    points=[0.0], epsabs=1e-15, epsrel=1e-12, limit=200)[0]
+    got = SECTION.line_volume_m3(depth0, gradient, 1.27, -1.27)
+    assert got == pytest.approx(expected, rel=1e-6, abs=1e-12)
+
+
+def test_grounded_volume_with_struts_exceeds_the_bare_cylinders_only_above_the_float_line():
+    args = (SLOPE, 0.25, 1.27, -1.27, R)
+    shallow = buoyancy.grounded_volume_m3(2.0, *args)
+    assert buoyancy.grounded_volume_m3(2.0, *args, section=SECTION) == pytest.approx(shallow)
+    deep_cylinders = buoyancy.grounded_volume_m3(12.0, *args)
+    assert deep_cylinders == pytest.approx(2 * math.pi * R * R * 2.54)    # the cylinders, full
+    assert buoyancy.grounded_volume_m3(12.0, *args, section=SECTION) > 1.2 * deep_cylinders

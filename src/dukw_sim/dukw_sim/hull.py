@@ -1,12 +1,12 @@
 """Hull strips: buoyancy, wave forces and the seakeeping constants of the twin-cylinder hull.
 
 Each SWATH hull is a right circular cylinder (vehicle.md section 6) cut into equal
-strips; a strip's immersed section is the circular segment under the instantaneous
-water surface (``dukw_estimation.buoyancy.segment_area_m2``), so the hull's volume is
-``buoyancy.hull_volume_from_depths`` up to the float line. The cylinders alone are
-almost wholly immersed when afloat (0.288 of 0.313 m^3): 4 cm above the float line
-their waterplane vanishes and a 28 cm wave would leave heave and pitch without
-stiffness. Above the float line each hull therefore continues wall-sided (the SWATH
+strips; a strip's immersed section is ``dukw_estimation.buoyancy.HullSection`` under the
+instantaneous water surface (the estimator's section too): the circular segment up to
+the float line, so the hull's volume is ``buoyancy.hull_volume_from_depths`` there. The
+cylinders alone are almost wholly immersed when afloat (0.288 of 0.313 m^3): 4 cm above
+the float line their waterplane vanishes and a 28 cm wave would leave heave and pitch
+without stiffness. Above the float line each hull therefore continues wall-sided (the SWATH
 struts), with the waterplane area of vehicle.md section 1 (A_W = 0.89 m^2). The
 same strips give the heave force and the roll and pitch moments, and the Froude-Krylov
 surge force from the water's particle acceleration. The rigid-body inertias (with added
@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dukw_common.vehicle import Vehicle
-from dukw_estimation.buoyancy import segment_area_m2
+from dukw_estimation.buoyancy import HullSection, segment_area_m2
 
 from dukw_sim.params import SeakeepingParams
 
@@ -46,6 +46,8 @@ class HullGeometry:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, '_dry', np.zeros(self.station_x_m.size))
+        object.__setattr__(self, 'section', HullSection(self.radius_m, self.float_depth_m,
+                                                        self.strut_width_m))
 
     @classmethod
     def from_vehicle(cls, vehicle: Vehicle, stations_per_hull: int) -> 'HullGeometry':
@@ -56,40 +58,22 @@ class HullGeometry:
         xs = -body.hull_length_m / 2.0 + dx * (np.arange(n) + 0.5)
         p = body.hull_separation_m / 2.0
         bottom = body.hull_clearance_m - body.kg_m
-        float_depth = cylinder_float_depth_m(body.displaced_volume_m3, body.hull_radius_m,
-                                             body.hull_length_m)
-        strut = body.waterplane_area_m2 / (2.0 * body.hull_length_m)
+        section = HullSection.of_hulls(body.displaced_volume_m3, body.hull_radius_m,
+                                       body.hull_length_m, body.waterplane_area_m2)
         return cls(np.concatenate([xs, xs]), np.concatenate([np.full(n, p), np.full(n, -p)]),
                    dx, body.hull_radius_m, bottom, bottom + body.hull_radius_m, n,
-                   float_depth, strut)
+                   section.float_depth_m, section.strut_width_m)
 
     def areas_m2(self, depth_over_bottom_m: np.ndarray) -> np.ndarray:
         """Immersed section of each strip from the water height over its bottom, m^2.
 
-        The cylinder's circular segment up to the float line, wall-sided above it.
+        The cylinder's circular segment up to the float line, wall-sided above it
+        (``buoyancy.HullSection``, the estimator's section too).
         """
         d = depth_over_bottom_m
         if d.max() <= 0.0:
             return self._dry
-        above = d - self.float_depth_m
-        return (segment_area_m2(np.minimum(d, self.float_depth_m), self.radius_m)
-                + self.strut_width_m * np.maximum(above, 0.0))
-
-
-def cylinder_float_depth_m(displaced_volume_m3: float, radius_m: float,
-                           length_m: float) -> float:
-    """Water over the bottoms of two level cylinders that displace the volume given, m."""
-    target = displaced_volume_m3 / (2.0 * length_m)
-    if target >= math.pi * radius_m ** 2:
-        raise ValueError('the hulls cannot carry the displacement (hull_radius_m too small)')
-    lo, hi = 0.0, 2.0 * radius_m
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        if float(segment_area_m2(mid, radius_m)) < target:
-            lo = mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
+        return self.section.area_m2(d)
 
 
 @dataclass(frozen=True)
