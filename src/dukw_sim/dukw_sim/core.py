@@ -174,6 +174,7 @@ class SimCore:
         gz, gpitch, groll, _ = self._ground_pose()
         self.z_cg, self.pitch, self.roll = gz + self._kg, gpitch, groll
         self.in_contact = True
+        self.grazing = False
         if self._grounded_buoyancy() >= self._weight:
             self.in_contact = False
             self.z_cg = self._float_height()
@@ -279,9 +280,9 @@ class SimCore:
         # --- contact: lift off when the water carries the weight
         if self.in_contact and buoy >= self._weight:
             self.in_contact = False
-        if self.in_contact:
-            w_eff = traction.effective_weight_n(self._weight, volume, slope,
-                                                veh.body.water_density_kgpm3, self._g)
+        if self.in_contact or self.grazing:
+            w_eff = max(traction.effective_weight_n(self._weight, volume, slope,
+                                                    veh.body.water_density_kgpm3, self._g), 0.0)
         else:
             w_eff = 0.0
 
@@ -466,6 +467,7 @@ class SimCore:
             self.z_cg += dt * self.heave_vel
             self.roll += dt * self.roll_rate
             self.pitch += dt * self.pitch_rate
+            self.grazing = False
             self._touchdown()
         self.t_s += dt
         accel = ((self.u - u0) / dt - self.r * self.v, (self.v - v0) / dt + self.r * self.u,
@@ -538,16 +540,31 @@ class SimCore:
         return t if pct >= 0.0 else t * drive.prop_reverse_thrust_ratio
 
     def _touchdown(self) -> None:
-        """Land on the sand when a track end reaches it (an inelastic contact)."""
+        """Land on the sand when a track end reaches it (an inelastic contact).
+
+        Unless the water would carry the whole weight of the vehicle lying there: the sand
+        can only push up, so it cannot hold a buoyant hull down. The hull then grazes the
+        sand with a track end (``grazing``): it is kept out of it, any downward heave is
+        stopped, it goes on pitching and rolling afloat, and the sand carries what the water
+        does not (the weight less the buoyancy, on the tracks).
+        """
         gz, gpitch, groll, _ = self._ground_pose()
         base = self.z_cg - self._kg
         half = self._track_len / 2.0
         lowest = base - half * abs(math.sin(self.pitch - gpitch)) \
             - self._half_sep * abs(math.sin(self.roll - groll))
-        if lowest <= gz:
-            self.in_contact = True
-            self.z_cg, self.pitch, self.roll = gz + self._kg, gpitch, groll
-            self.heave_vel = self.roll_rate = self.pitch_rate = 0.0
+        if lowest > gz:
+            return
+        floating = (self.z_cg, self.pitch, self.roll)
+        self.z_cg, self.pitch, self.roll = gz + self._kg, gpitch, groll
+        if self._grounded_buoyancy() >= self._weight:
+            self.z_cg, self.pitch, self.roll = floating
+            self.z_cg += gz - lowest
+            self.heave_vel = max(self.heave_vel, 0.0)
+            self.grazing = True
+            return
+        self.in_contact = True
+        self.heave_vel = self.roll_rate = self.pitch_rate = 0.0
 
     # ---------------------------------------------------------------------- truth
     def _compute_truth(self, act: Actuation, stepped) -> Truth:
@@ -579,7 +596,7 @@ class SimCore:
             thrust = [0.0, 0.0]
             w_eff = traction.effective_weight_n(self._weight, volume, math.atan(abs(
                 beach.gradient(self.x))), veh.body.water_density_kgpm3, self._g) \
-                if self.in_contact else 0.0
+                if self.in_contact or self.grazing else 0.0
             fwx = fwy = 0.0
             accel = (0.0, 0.0, 0.0)
         else:
@@ -597,7 +614,9 @@ class SimCore:
                   * min(abs(thrust[i]) / drive.max_prop_thrust_n, 1.0) ** 1.5 for i in range(2)]
         battery = drive.motor_voltage_v - self.params.battery_internal_resistance_ohm * (
             abs(currents[0]) + abs(currents[1]) + prop_i[0] + prop_i[1])
-        if not self.in_contact:
+        # touching now, or during the step just taken (its track forces acted on the sand)
+        touching = self.in_contact or self.grazing or w_eff > 0.0
+        if not touching:
             medium = Medium.WATER
         elif volume < _LAND_FRACTION * self._afloat_volume:
             medium = Medium.LAND
@@ -624,7 +643,7 @@ class SimCore:
             battery_voltage_v=battery,
             submerged_volume_m3=volume, effective_weight_n=w_eff,
             weight_on_tracks_fraction=(max(self._weight - self._rho_g * volume, 0.0)
-                                       / self._weight if self.in_contact else 0.0),
+                                       / self._weight if touching else 0.0),
             waterline_distance_m=beach.distance_along_slope_m(self.x),
             slope_rad=slope, ground_height_m=ground,
             wave_elevation_m=eta[0], water_depth_m=eta[0] - ground,
@@ -633,4 +652,4 @@ class SimCore:
             aft_sensor_depth_m=eta[2] - sensor_z(sens.aft_water_x_m,
                                                              sens.aft_water_z_m),
             sounder_depth_m=sounder, medium=medium,
-            wave_surge_force_n=c * fwx + s * fwy, in_ground_contact=self.in_contact)
+            wave_surge_force_n=c * fwx + s * fwy, in_ground_contact=touching)
