@@ -106,7 +106,8 @@ def cylinder_float_depth_m(displaced_volume_m3: float, radius_m: float,
 @dataclass(frozen=True)
 class HullSection:
     """Cross-section of each SWATH hull: the paper's cylinder up to the float line, then
-    wall-sided (the strut) with the waterplane area of vehicle.md section 1 above it.
+    wall-sided (the strut) with the waterplane area of vehicle.md section 1 above it, up
+    to the deck; water over the deck displaces nothing more.
 
     The cylinders alone are almost wholly immersed afloat (0.288 of 0.313 m^3), so a crest
     over the float line meets the strut. The simulator's strips and the estimator's
@@ -116,28 +117,45 @@ class HullSection:
     radius_m: float
     float_depth_m: float         # water over the hull bottom afloat in calm water
     strut_width_m: float         # wall-sided width above the float line
+    top_depth_m: float = math.inf   # the deck, above the hull bottom
 
     @classmethod
     def of_hulls(cls, displaced_volume_m3: float, radius_m: float, length_m: float,
-                 waterplane_area_m2: float) -> 'HullSection':
+                 waterplane_area_m2: float, top_depth_m: float = math.inf) -> 'HullSection':
         """Float line from the displacement, strut width from the waterplane of two hulls."""
         return cls(radius_m, cylinder_float_depth_m(displaced_volume_m3, radius_m, length_m),
-                   waterplane_area_m2 / (2.0 * length_m))
+                   waterplane_area_m2 / (2.0 * length_m), top_depth_m)
+
+    @classmethod
+    def of_body(cls, body) -> 'HullSection':
+        """The section of ``dukw_common.vehicle`` Body's hulls (deck: keel-to-deck depth)."""
+        return cls.of_hulls(body.displaced_volume_m3, body.hull_radius_m, body.hull_length_m,
+                            body.waterplane_area_m2,
+                            body.depth_keel_to_deck_m - body.hull_clearance_m)
 
     def area_m2(self, depth_m: ArrayLike) -> ArrayLike:
         """Immersed section from the water height over the hull bottom, m^2 (vectorised)."""
-        d = np.asarray(depth_m, dtype=float)
+        d = np.minimum(np.asarray(depth_m, dtype=float), self.top_depth_m)
         out = segment_area_m2(np.minimum(d, self.float_depth_m), self.radius_m) \
             + self.strut_width_m * np.maximum(d - self.float_depth_m, 0.0)
         return float(out) if np.ndim(out) == 0 else out
 
+    def max_area_m2(self) -> float:
+        """The whole section, deck awash (unbounded for a strut without a deck), m^2."""
+        if math.isfinite(self.top_depth_m):
+            return float(self.area_m2(self.top_depth_m))
+        return math.pi * self.radius_m ** 2 if self.strut_width_m == 0.0 else math.inf
+
     def area_integral_m3_per_m(self, depth_m: float) -> float:
         """int_0^d area(u) du, m^3/m: the volume of a hull dipping 1 m per metre to depth d."""
+        over_deck = max(depth_m - self.top_depth_m, 0.0)
+        depth_m = min(depth_m, self.top_depth_m)
         f = self.float_depth_m
         above = max(depth_m - f, 0.0)
         return segment_area_integral_m3_per_m(min(depth_m, f), self.radius_m) \
             + float(segment_area_m2(f, self.radius_m)) * above \
-            + 0.5 * self.strut_width_m * above * above
+            + 0.5 * self.strut_width_m * above * above \
+            + (float(self.area_m2(self.top_depth_m)) * over_deck if over_deck > 0.0 else 0.0)
 
     def line_volume_m3(self, depth0_m: float, gradient: float, bow_x_m: float,
                        stern_x_m: float) -> float:

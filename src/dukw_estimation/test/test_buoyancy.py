@@ -106,3 +106,24 @@ def test_grounded_volume_with_struts_exceeds_the_bare_cylinders_only_above_the_f
     deep_cylinders = buoyancy.grounded_volume_m3(12.0, *args)
     assert deep_cylinders == pytest.approx(2 * math.pi * R * R * 2.54)    # the cylinders, full
     assert buoyancy.grounded_volume_m3(12.0, *args, section=SECTION) > 1.2 * deep_cylinders
+
+
+DECKED = buoyancy.HullSection.of_hulls(0.2878, R, 2.54, 0.89, top_depth_m=0.36)
+
+
+def test_water_over_the_deck_displaces_nothing_more():
+    top = DECKED.area_m2(0.36)
+    assert DECKED.area_m2(0.5) == top == DECKED.max_area_m2()
+    assert DECKED.area_m2(0.3) == SECTION.area_m2(0.3)
+    assert DECKED.area_integral_m3_per_m(0.6) == pytest.approx(
+        DECKED.area_integral_m3_per_m(0.36) + 0.24 * top)
+    assert buoyancy.HullSection(R, 2 * R, 0.0).max_area_m2() == pytest.approx(math.pi * R * R)
+    assert SECTION.max_area_m2() == math.inf
+
+
+@pytest.mark.parametrize('depth0, gradient', [(0.3, 0.1), (0.5, -0.05), (0.2, 0.3)])
+def test_decked_line_volume_is_the_section_integrated(depth0, gradient):
+    expected = quad(lambda x: float(DECKED.area_m2(depth0 + gradient * x)), -1.27, 1.27,
+                    epsabs=1e-15, epsrel=1e-12, limit=200)[0]
+    assert DECKED.line_volume_m3(depth0, gradient, 1.27, -1.27) == pytest.approx(
+        expected, rel=1e-6)

@@ -41,13 +41,10 @@ class HullGeometry:
     bottom_above_cg_m: float     # hull bottom height relative to the centre of gravity (< 0)
     axis_above_cg_m: float
     stations_per_hull: int
-    float_depth_m: float         # water over the hull bottom when afloat in calm water
-    strut_width_m: float         # wall-sided width of each hull above the float line
+    section: HullSection         # each hull's cross-section (shared with the estimator)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, '_dry', np.zeros(self.station_x_m.size))
-        object.__setattr__(self, 'section', HullSection(self.radius_m, self.float_depth_m,
-                                                        self.strut_width_m))
 
     @classmethod
     def from_vehicle(cls, vehicle: Vehicle, stations_per_hull: int) -> 'HullGeometry':
@@ -58,17 +55,25 @@ class HullGeometry:
         xs = -body.hull_length_m / 2.0 + dx * (np.arange(n) + 0.5)
         p = body.hull_separation_m / 2.0
         bottom = body.hull_clearance_m - body.kg_m
-        section = HullSection.of_hulls(body.displaced_volume_m3, body.hull_radius_m,
-                                       body.hull_length_m, body.waterplane_area_m2)
         return cls(np.concatenate([xs, xs]), np.concatenate([np.full(n, p), np.full(n, -p)]),
                    dx, body.hull_radius_m, bottom, bottom + body.hull_radius_m, n,
-                   section.float_depth_m, section.strut_width_m)
+                   HullSection.of_body(body))
+
+    @property
+    def float_depth_m(self) -> float:
+        """Water over the hull bottom when afloat in calm water, m."""
+        return self.section.float_depth_m
+
+    @property
+    def strut_width_m(self) -> float:
+        """Wall-sided width of each hull above the float line, m."""
+        return self.section.strut_width_m
 
     def areas_m2(self, depth_over_bottom_m: np.ndarray) -> np.ndarray:
         """Immersed section of each strip from the water height over its bottom, m^2.
 
-        The cylinder's circular segment up to the float line, wall-sided above it
-        (``buoyancy.HullSection``, the estimator's section too).
+        The cylinder's circular segment up to the float line, wall-sided above it up to the
+        deck (``buoyancy.HullSection``, the estimator's section too).
         """
         d = depth_over_bottom_m
         if d.max() <= 0.0:
