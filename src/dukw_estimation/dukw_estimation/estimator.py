@@ -43,8 +43,12 @@ class Estimator:
         # simulator's hull strips; inside bow_x_m .. stern_x_m of the overall length
         self.hull_bow_x_m = min(0.5 * body.hull_length_m, body.bow_x_m)
         self.hull_stern_x_m = max(-0.5 * body.hull_length_m, body.stern_x_m)
-        self.section = buoyancy.HullSection.of_hulls(body.displaced_volume_m3, body.hull_radius_m,
-                                                     body.hull_length_m, body.waterplane_area_m2)
+        self.section = buoyancy.HullSection.of_body(body)
+        # the most the hulls can displace, deck awash
+        self.max_volume_m3 = 2.0 * self.section.max_area_m2() * body.hull_length_m
+        # lying this deep (halfway from the displacement to the deck awash) it floats, whatever
+        # the IMU says
+        self.sure_float_m3 = 0.5 * (body.displaced_volume_m3 + self.max_volume_m3)
         self.track_area_m2 = body.track_width_m * body.track_contact_length_m
         self.heave_mass_kg = buoyancy.heave_mass_kg(body.waterplane_area_m2,
                                                     body.water_density_kgpm3,
@@ -102,10 +106,20 @@ class Estimator:
         x = self.ekf.x
         seaward = ((x[Idx.X] - st.waterline_x_m) * math.cos(st.seaward_yaw_rad)
                    + (x[Idx.Y] - st.waterline_y_m) * math.sin(st.seaward_yaw_rad))
-        x[Idx.S] = seaward / math.cos(self.vehicle.site.beach_slope_rad)
-        self.ekf.P[Idx.S, :] = 0.0
-        self.ekf.P[:, Idx.S] = 0.0
-        self.ekf.P[Idx.S, Idx.S] = st.waterline_sigma_m ** 2 + self.ekf.P[Idx.X, Idx.X]
+        inv_cos = 1.0 / math.cos(self.vehicle.site.beach_slope_rad)
+        x[Idx.S] = seaward * inv_cos
+        # s is the seaward position along the slope plus the waterline's survey error: it is
+        # correlated with x, y as they are, so the GPS's later corrections of the position
+        # (its drift averaged out) move s too
+        j = np.zeros(N_STATES)
+        j[Idx.X] = math.cos(st.seaward_yaw_rad) * inv_cos
+        j[Idx.Y] = math.sin(st.seaward_yaw_rad) * inv_cos
+        P = self.ekf.P
+        cross = P @ j
+        cross[Idx.S] = 0.0
+        P[Idx.S, :] = cross
+        P[:, Idx.S] = cross
+        P[Idx.S, Idx.S] = float(j @ cross) + st.waterline_sigma_m ** 2
 
     # ------------------------------------------------------------------ time
     def _fresh(self, sensor: str, t_s: float) -> bool:
@@ -465,9 +479,13 @@ class Estimator:
         """
         displaced = self.vehicle.body.displaced_volume_m3
         limit = displaced * (TOUCHDOWN_SHARE if self.afloat else 1.0)
+        imu_fresh = self.imu is not None and self.t_s is not None and self._fresh('imu', self.t_s)
         if grounded_volume_m3 >= limit:
-            return True                  # deep enough to float even in calm water
-        if self.imu is not None and self.t_s is not None and self._fresh('imu', self.t_s):
+            # deep enough to float even in calm water - unless the IMU says the vehicle lies
+            # still on the sand, in a trough the estimated surface does not show
+            return not imu_fresh or self.motion > 1.0 \
+                or grounded_volume_m3 >= self.sure_float_m3
+        if imu_fresh:
             return self.motion > 1.0 and \
                 grounded_volume_m3 >= self.settings.contact_min_volume_share * displaced
         return False
@@ -485,7 +503,7 @@ class Estimator:
         volume = buoyancy.afloat_dynamic_volume_m3(body.displacement_n, self.heave_mass_kg,
                                                    heave_accel, body.water_density_kgpm3,
                                                    body.gravity_mps2)
-        return min(max(volume, 0.0), 2.0 * body.displaced_volume_m3)
+        return min(max(volume, 0.0), self.max_volume_m3)
 
     def health(self, now_s: float) -> list[Health]:
         """One Health per sensor (stale -> WARN, rejections counted) and one for the filter."""

@@ -227,3 +227,42 @@ def test_force_smoother_reduces_noise_and_follows_a_step():
     assert not smoother.update(30.0, math.nan)
     with pytest.raises(ValueError):
         ForceSmoother(0.0, 1.0)
+
+
+def test_the_waterline_distance_follows_the_gps_correcting_a_bad_first_fix():
+    """s is the position along the slope: when later fixes pull a 1.5 m-off first fix back,
+    s comes back with it (it did not while s was decorrelated from x at the first fix)."""
+    slope = VEHICLE.site.beach_slope_rad
+    est = make(wave_sigma_m=0.01)
+    est.add_gps_fix(fix(0.005, -18.5, 0.0))            # the vehicle is at x = -20
+    drive = Drive(est, u=0.2, r=0.0, x=-20.0)
+    drive.run(20.0, track_speed=(0.2, 0.2))
+    x_error = est.odometry().x_m - drive.x
+    s_error = est.traction().waterline_distance_m - drive.x / math.cos(slope)
+    assert abs(x_error) < 0.75                         # pulled back at least halfway
+    assert s_error == pytest.approx(x_error / math.cos(slope), abs=0.1)
+
+
+def test_lying_still_in_a_trough_is_on_the_sand_though_the_mean_surface_would_float_it():
+    """6 m out the mean surface puts 0.9 of the displacement under water: afloat while the
+    hull rolls, but once the IMU shows it lying still the sand carries weight again."""
+    slope = VEHICLE.site.beach_slope_rad
+    est = make(wave_sigma_m=0.01)
+    drive = Drive(est, u=0.0, r=0.0, x=6.0, pitch=slope)
+    drive.run(1.0, track_speed=(0.0, 0.0))
+    assert not est.traction().afloat                   # still, and 0.9 < 1: on the sand
+    t = drive.t
+    for k in range(300):                               # rolling and heaving like a hull afloat
+        t += 0.01
+        w = 0.5 * math.sin(2 * math.pi * 0.4 * t)
+        est.add_imu(ImuSample(t, 0.1 * w, slope, 0.0, w, 0.0, 0.0, -G * math.sin(slope), 0.0,
+                              G + 2.0 * w))
+        if k % 10 == 0:
+            est.add_gps_fix(fix(t, 6.0, 0.0))
+            est.add_gps_velocity(GpsVelocity(t, 0.0, 0.0))
+    assert est.traction().afloat
+    drive.t = t
+    drive.run(1.0, track_speed=(0.0, 0.0))             # lying still again
+    out = est.traction()
+    assert not out.afloat
+    assert out.weight_on_tracks_fraction > 0.05
