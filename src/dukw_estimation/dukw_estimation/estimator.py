@@ -11,7 +11,6 @@ import math
 from collections import defaultdict
 
 import numpy as np
-from scipy.special import log_ndtr
 
 from dukw_common.diagnostics import Health, Level, RateCounter
 from dukw_common.geometry import local_enu_from_geodetic, wrap_angle
@@ -26,8 +25,6 @@ from dukw_estimation.samples import (DepthReading, DriveStatus, GpsFix, GpsVeloc
 from dukw_estimation.settings import SENSORS, EkfSettings
 
 MAX_PREDICT_STEP_S = 0.02
-_LOG_SQRT_2PI = 0.5 * math.log(2.0 * math.pi)
-CERTAIN_SIGMAS = 6.0             # a wet/dry reading this many sigma on the state's side: no news
 GROUNDED_FRACTION = 0.5          # above this weight share the tracks drive the vehicle
 SLOPE_FRACTION = 0.9             # above this share the pitch is the beach's, not the waves'
 TOUCHDOWN_SHARE = 0.8           # afloat until the mean-surface volume drops below this share
@@ -91,7 +88,6 @@ class Estimator:
         self.afloat = False
         self.motion = 0.0                # > 1: rolling, pitching, heaving like a floating hull
         self._fraction_t_s = -math.inf
-        self._contact_t = {'fore': -math.inf, 'aft': -math.inf}
         self.force = [ForceSmoother(st.force_process_n_per_s, st.force_measurement_n)
                       for _ in range(2)]
 
@@ -327,11 +323,7 @@ class Estimator:
         return self._count('gps_vel', out)
 
     def add_water_contact(self, s: WaterContact) -> Outcome:
-        """Wet/dry sensors: the water over each sensor is > 0 (wet) or < 0 (dry).
-
-        A reading that contradicts the state pulls the surface across the sensor at once; one
-        that agrees is applied again only every ``contact.repeat_period_s``.
-        """
+        """Wet/dry sensors: where the state disagrees, the surface is at the sensor."""
         rejected = self._admit('water', s.t_s, ())
         if rejected:
             return rejected
@@ -339,43 +331,19 @@ class Estimator:
             # floating, the sensors ride with the hull, not at a height above the sand
             return self._count('water', Outcome.ACCEPTED)
         mounts = self.vehicle.sensors
-        out = Outcome.ACCEPTED
-        for name, wet, x_m, z_m in (
-                ('fore', s.fore_wet, mounts.fore_water_x_m, mounts.fore_water_z_m),
-                ('aft', s.aft_wet, mounts.aft_water_x_m, mounts.aft_water_z_m)):
+        out = Outcome.IGNORED
+        for wet, x_m, z_m in ((s.fore_wet, mounts.fore_water_x_m, mounts.fore_water_z_m),
+                              (s.aft_wet, mounts.aft_water_x_m, mounts.aft_water_z_m)):
             depth, h = self._sensor_depth(x_m, z_m)
-            agrees = bool(wet) == (depth > 0.0)
-            if agrees and s.t_s - self._contact_t[name] < self.settings.contact_repeat_s:
+            if bool(wet) == (depth > 0.0):
                 continue
-            self._contact_t[name] = s.t_s
-            if self._wet_or_dry(bool(wet), depth, h) is Outcome.REJECTED_OUTLIER:
-                out = Outcome.REJECTED_OUTLIER
+            result = self.ekf.update_scalar(0.0, depth, h, self.settings.contact_m ** 2,
+                                            self.settings.gate_water, only=SURFACE_STATES)
+            if out is not Outcome.REJECTED_OUTLIER:
+                out = result
+        if out is Outcome.IGNORED:
+            out = Outcome.ACCEPTED    # consistent with the state: nothing to correct
         return self._count('water', out)
-
-    def _wet_or_dry(self, wet: bool, depth_m: float, h: np.ndarray) -> Outcome:
-        """Bayes for one binary reading at a sensor whose predicted water depth is depth_m.
-
-        The prediction N(depth, h P h' + contact^2) cut at 0 on the side read is a truncated
-        normal; its mean and variance become one equivalent scalar measurement (assumed-
-        density filtering), so the surface moves inside the wet (or dry) side by as much as
-        the state was unsure, not just onto the boundary. Beyond the gate: an outlier.
-        """
-        st = self.settings
-        noise = st.contact_m ** 2
-        prior = float(h @ self.ekf.P @ h) + noise
-        sigma = math.sqrt(prior)
-        side = 1.0 if wet else -1.0
-        t = side * depth_m / sigma                 # margin on the side read, in sigmas
-        if t < -st.gate_water:
-            return Outcome.REJECTED_OUTLIER
-        if t > CERTAIN_SIGMAS:
-            return Outcome.ACCEPTED
-        mills = math.exp(-0.5 * t * t - _LOG_SQRT_2PI - float(log_ndtr(t)))   # phi / Phi
-        mean = depth_m + side * sigma * mills
-        var = max(prior * (1.0 - mills * (t + mills)), 1e-6 * prior)
-        r = 1.0 / (1.0 / var - 1.0 / prior)        # the measurement that gives that posterior
-        z = r * (mean / var - depth_m / prior)
-        return self.ekf.update_scalar(z, depth_m, h, r + noise, math.inf, only=SURFACE_STATES)
 
     def _sensor_depth(self, x_m: float, z_m: float) -> tuple[float, np.ndarray]:
         """Water over a sensor at body (x, z) of a vehicle on the slope, and its Jacobian."""

@@ -108,10 +108,6 @@ class EkfSettings:
     contact_min_volume_share: float = _f('contact.min_volume_share',
                                          'floating needs at least this share of the '
                                          'displacement under water (bumps on land)', 0, 1)
-    contact_repeat_s: float = _f('contact.repeat_period_s', 'a wet/dry reading the state '
-                                 'already agrees with is applied again after this long (the '
-                                 'same reading carries little news from sample to sample)',
-                                 0, 60)
     gps_bias_sigma_m: float = _f('gps_bias.sigma_m', 'slowly drifting DGPS position error '
                                  'sigma (0: no bias states, message covariance used)', 0, 100)
     gps_bias_tau_s: float = _f('gps_bias.tau_s', 'correlation time of the DGPS error', 0.01,

@@ -266,28 +266,3 @@ def test_lying_still_in_a_trough_is_on_the_sand_though_the_mean_surface_would_fl
     out = est.traction()
     assert not out.afloat
     assert out.weight_on_tracks_fraction > 0.05
-
-
-def test_a_wet_or_dry_reading_moves_the_surface_inside_its_side_of_the_sensor():
-    slope = VEHICLE.site.beach_slope_rad
-    mounts = VEHICLE.sensors
-    # where the mean surface is 3 cm over the fore sensor of a vehicle facing the sea
-    s_fore = (mounts.fore_water_z_m * math.cos(slope) + 0.03) / math.sin(slope) \
-        - mounts.fore_water_x_m
-    x = s_fore * math.cos(slope)
-    est = make(waterline_sigma_m=0.05)
-    drive = Drive(est, u=0.0, r=0.0, x=x, pitch=slope)
-    drive.run(2.0, track_speed=(0.0, 0.0))
-
-    def fore_depth():
-        return est._sensor_depth(mounts.fore_water_x_m, mounts.fore_water_z_m)[0]
-    before = fore_depth()
-    assert 0.0 < before < 0.06
-    t = drive.t + 0.005
-    assert est.add_water_contact(WaterContact(t, True, False)) is Outcome.ACCEPTED
-    inside = fore_depth()
-    assert inside > before + 0.005                     # wet: into the wet side, not onto 0
-    est.add_water_contact(WaterContact(t + 0.05, True, False))
-    assert fore_depth() == pytest.approx(inside, abs=1e-3)   # the same news, not re-applied
-    est.add_water_contact(WaterContact(t + 0.1, False, False))
-    assert fore_depth() < 0.0                          # read dry: across the sensor at once
