@@ -101,6 +101,15 @@ class Estimator:
         self.position_set = self.yaw_set = True
         return True
 
+    def pin_surface(self, waterline_distance_m: float, wave_elevation_m: float) -> bool:
+        """Set the waterline distance and the wave at base_link, m (a diagnostic: what the
+        submersion would be with the surface known, ``evaluate --oracle-surface``)."""
+        if not (math.isfinite(waterline_distance_m) and math.isfinite(wave_elevation_m)):
+            return False
+        self.ekf.x[Idx.S] = waterline_distance_m
+        self.ekf.x[Idx.ETA] = wave_elevation_m
+        return True
+
     def _init_waterline(self) -> None:
         st = self.settings
         x = self.ekf.x
