@@ -88,6 +88,8 @@ class Estimator:
         self.afloat = False
         self.motion = 0.0                # > 1: rolling, pitching, heaving like a floating hull
         self._fraction_t_s = -math.inf
+        self._force_update_t = -math.inf
+        self._grounded_since_s = math.inf
         self.force = [ForceSmoother(st.force_process_n_per_s, st.force_measurement_n)
                       for _ in range(2)]
 
@@ -401,7 +403,74 @@ class Estimator:
             smoother.update(s.t_s, force)
         if not self._fresh('gps_vel', s.t_s) and self.fraction > GROUNDED_FRACTION:
             self._track_odometry(s)
+        self._track_force_update(s)
         return self._count('tracks', Outcome.ACCEPTED)
+
+    def _track_force_update(self, s: DriveStatus) -> None:
+        """The smoothed track forces against the Wong force of the estimated weight: a
+        measurement of the surface (vehicle.md 6), where both tracks slip enough for the
+        force to depend on the weight, the vehicle has lain on the sand a while (the
+        smoother lags a touchdown) and the weight is not all on the tracks or all afloat."""
+        st = self.settings
+        if self.afloat:
+            self._grounded_since_s = math.inf
+            return
+        self._grounded_since_s = min(self._grounded_since_s, s.t_s)
+        if st.force_update_sigma_n <= 0.0 \
+                or s.t_s - self._grounded_since_s < st.force_update_settle_s \
+                or s.t_s - self._force_update_t < st.force_update_period_s:
+            return
+        self._force_update_t = s.t_s
+        x = self.ekf.x
+        speeds = (s.port.speed_mps, s.stbd.speed_mps)
+        ground = self._ground_speeds()
+        slips = [float(traction.slip(speeds[k], ground[k])) for k in range(2)]
+        if not all(abs(i) >= st.force_update_min_slip for i in slips):
+            return
+        # the drivetrain's own friction (the no-load current) opposes the belt, not the sand
+        friction = self.vehicle.drivetrain.no_load_current_a \
+            * self.vehicle.drivetrain.track_force_gain_n_per_a
+        measured = [self.force[k].force_n - math.copysign(friction, speeds[k])
+                    for k in range(2)]
+        if not all(math.isfinite(m) for m in measured):
+            return
+        slope = self.slope_rad
+        sin_t = math.sin(slope)
+        step_m = 0.005
+        for k in range(2):
+            predicted = self._soil_force_n(x[Idx.S], x[Idx.ETA], slips[k])
+            per_m = (self._soil_force_n(x[Idx.S], x[Idx.ETA] + step_m, slips[k])
+                     - predicted) / step_m
+            if abs(per_m) < 1e-3:
+                continue                 # all weight on the tracks, or none: no news
+            h = np.zeros(N_STATES)
+            h[Idx.ETA] = per_m
+            h[Idx.S] = per_m * sin_t     # the volume follows the water depth eta + s sin
+            self.ekf.update_scalar(measured[k], predicted, h, st.force_update_sigma_n ** 2,
+                                   st.force_update_gate, only=SURFACE_STATES)
+
+    def _ground_speeds(self) -> tuple[float, float]:
+        """Ground speed under the port and starboard tracks, m/s."""
+        x = self.ekf.x
+        half = 0.5 * self.vehicle.body.hull_separation_m
+        return x[Idx.U] - x[Idx.R] * half, x[Idx.U] + x[Idx.R] * half
+
+    def _soil_force_n(self, waterline_distance_m: float, surface_m: float,
+                      slip_: float) -> float:
+        """Wong force of one track at this slip, with the weight the surface leaves it, N."""
+        body = self.vehicle.body
+        heading_cos = math.cos(self.ekf.x[Idx.YAW] - self.settings.seaward_yaw_rad)
+        volume = buoyancy.grounded_volume_m3(waterline_distance_m, self.slope_rad,
+                                             body.hull_clearance_m, self.hull_bow_x_m,
+                                             self.hull_stern_x_m, body.hull_radius_m,
+                                             surface_m, heading_cos, self.section)
+        weight = traction.effective_weight_n(body.displacement_n,
+                                             min(volume, body.displaced_volume_m3),
+                                             self.slope_rad, body.water_density_kgpm3,
+                                             body.gravity_mps2)
+        return float(traction.tractive_force_n(slip_, 0.5 * weight, self.soil,
+                                               self.track_area_m2,
+                                               body.track_contact_length_m))
 
     def _track_odometry(self, s: DriveStatus) -> None:
         """GPS velocity stale on land: the tracks say roughly how fast we go."""
@@ -462,8 +531,7 @@ class Estimator:
             body.displacement_n, volume, slope, body.water_density_kgpm3, body.gravity_mps2)
         self.fraction = weight / (body.displacement_n * math.cos(slope))
         self._fraction_t_s = self.t_s or 0.0
-        half = 0.5 * body.hull_separation_m
-        ground = (x[Idx.U] - x[Idx.R] * half, x[Idx.U] + x[Idx.R] * half)
+        ground = self._ground_speeds()
         slips = [math.nan, math.nan]
         predicted = [math.nan, math.nan]
         if self.tracks is not None:

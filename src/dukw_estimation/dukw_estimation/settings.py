@@ -127,6 +127,18 @@ class EkfSettings:
                                       'track-force smoother: force rate noise', 1e-3, 1e5)
     force_measurement_n: float = _f('force_filter.measurement_n',
                                     'track-force smoother: current x gain noise', 1e-3, 1e4)
+    # the measured track forces as a measurement of the weight on the tracks
+    force_update_min_slip: float = _f('force_update.min_slip', 'both tracks slipping at least '
+                                      'this much: the Wong force then tells the weight', 0, 1)
+    force_update_sigma_n: float = _f('force_update.sigma_n', 'per track: current noise, '
+                                     'unmodelled friction and paddle thrust (0: off)', 0, 1e4)
+    force_update_period_s: float = _f('force_update.period_s', 'at most this often (the '
+                                      'smoothed force is correlated in time)', 0, 60)
+    force_update_settle_s: float = _f('force_update.settle_s', 'grounded at least this long '
+                                      '(the smoothed force lags a touchdown)', 0, 60)
+    force_update_gate: float = _f('force_update.mahalanobis', 'rejection distance: a force far '
+                                  'off the model is more likely the model failing (a track '
+                                  'half in the air, paddling) than the surface', 0.5, 1e6)
     soil_preset: str = _f('soil_preset', "soil preset name; '' uses soil.*")
 
     @classmethod

@@ -266,3 +266,58 @@ def test_lying_still_in_a_trough_is_on_the_sand_though_the_mean_surface_would_fl
     out = est.traction()
     assert not out.afloat
     assert out.weight_on_tracks_fraction > 0.05
+
+
+def _surf_run(est, true_surface_m, slip_, seconds=5.0, x0=5.0):
+    """Crawl seaward on the slope with both tracks slipping by slip_, under a surface
+    true_surface_m off the mean; the track forces are the Wong forces of the true weight."""
+    from dukw_estimation import buoyancy
+    slope = VEHICLE.site.beach_slope_rad
+    body, drive = VEHICLE.body, VEHICLE.drivetrain
+    section = buoyancy.HullSection.of_body(body)
+    soil = soil_params(PARAMS)
+    track_mps = 0.3
+    u = track_mps * (1.0 - slip_)
+    x, t, fraction = x0, 0.0, math.nan
+    for k in range(int(round(seconds / 0.01))):
+        t += 0.01
+        x += u * math.cos(slope) * 0.01
+        est.add_imu(imu(t, 0.0, 0.0, pitch=slope))
+        s_true = x / math.cos(slope)
+        volume = min(buoyancy.grounded_volume_m3(
+            s_true, slope, body.hull_clearance_m, est.hull_bow_x_m, est.hull_stern_x_m,
+            body.hull_radius_m, true_surface_m, 1.0, section), body.displaced_volume_m3)
+        weight = traction.effective_weight_n(body.displacement_n, volume, slope,
+                                             body.water_density_kgpm3, G)
+        fraction = weight / (body.displacement_n * math.cos(slope))
+        if k % 10 == 0:
+            est.add_gps_fix(fix(t, x, 0.0))
+            est.add_gps_velocity(GpsVelocity(t, u * math.cos(slope), 0.0))
+        if k % 5 == 0:
+            force = traction.tractive_force_n(slip_, 0.5 * weight, soil, est.track_area_m2,
+                                              body.track_contact_length_m) \
+                + drive.no_load_current_a * drive.track_force_gain_n_per_a
+            side = MotorSide(30.0, force / drive.track_force_gain_n_per_a, track_mps, force)
+            est.add_tracks(DriveStatus(t, side, side))
+    return fraction
+
+
+def test_slipping_track_forces_tell_the_weight_the_surface_leaves_on_the_tracks():
+    """In a trough 6 cm under the mean surface, the tracks carry more than the mean surface
+    says; slipping, their forces show it and pull the estimate most of the way there."""
+    told = make(wave_sigma_m=0.07, waterline_sigma_m=0.05)
+    truth = _surf_run(told, -0.06, 0.4)
+    deaf = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, force_update_sigma_n=0.0)
+    _surf_run(deaf, -0.06, 0.4)
+    off = abs(deaf.traction().weight_on_tracks_fraction - truth)
+    assert off > 0.1                                   # the mean surface alone is well off
+    assert abs(told.traction().weight_on_tracks_fraction - truth) < 0.4 * off
+
+
+def test_track_forces_are_not_used_at_low_slip():
+    quiet = make(wave_sigma_m=0.07, waterline_sigma_m=0.05)
+    _surf_run(quiet, -0.06, 0.05)
+    deaf = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, force_update_sigma_n=0.0)
+    _surf_run(deaf, -0.06, 0.05)
+    assert quiet.traction().weight_on_tracks_fraction == pytest.approx(
+        deaf.traction().weight_on_tracks_fraction, abs=1e-9)
