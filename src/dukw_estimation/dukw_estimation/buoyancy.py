@@ -146,6 +146,15 @@ class HullSection:
             return float(self.area_m2(self.top_depth_m))
         return math.pi * self.radius_m ** 2 if self.strut_width_m == 0.0 else math.inf
 
+    def heave_width_m(self, secant_m: float = 0.02) -> float:
+        """Waterline width of one hull for small heaves about the float line, m: the mean of
+        the strut's above it and the cylinder's secant over ``secant_m`` below it (the
+        cylinder widens downwards). Times rho g and the length: the heave stiffness."""
+        d0 = self.float_depth_m
+        cylinder = (float(segment_area_m2(d0, self.radius_m))
+                    - float(segment_area_m2(d0 - secant_m, self.radius_m))) / secant_m
+        return 0.5 * (self.strut_width_m + cylinder)
+
     def area_integral_m3_per_m(self, depth_m: float) -> float:
         """int_0^d area(u) du, m^3/m: the volume of a hull dipping 1 m per metre to depth d."""
         over_deck = max(depth_m - self.top_depth_m, 0.0)

@@ -50,7 +50,9 @@ class Estimator:
         # the IMU says
         self.sure_float_m3 = 0.5 * (body.displaced_volume_m3 + self.max_volume_m3)
         self.track_area_m2 = body.track_width_m * body.track_contact_length_m
-        self.heave_mass_kg = buoyancy.heave_mass_kg(body.waterplane_area_m2,
+        # the heave stiffness of the hulls' section about the float line (as the simulator's)
+        waterplane_m2 = 2.0 * self.section.heave_width_m() * body.hull_length_m
+        self.heave_mass_kg = buoyancy.heave_mass_kg(waterplane_m2,
                                                     body.water_density_kgpm3,
                                                     body.gravity_mps2, settings.heave_natural_hz)
         self.counters: dict[str, dict[Outcome, int]] = {s: defaultdict(int) for s in SENSORS}

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dukw_common.vehicle import Vehicle
-from dukw_estimation.buoyancy import HullSection, segment_area_m2
+from dukw_estimation.buoyancy import HullSection
 
 from dukw_sim.params import SeakeepingParams
 
@@ -102,13 +102,9 @@ class Seakeeping:
         """Inertias from the strip stiffness at the float line and the measured frequencies."""
         body = vehicle.body
         rho_g = body.water_density_kgpm3 * body.gravity_mps2
-        d0 = hull.float_depth_m
         # the waterplane is the strut's above the float line, the cylinder's (widening
-        # downwards) below it: an oscillation of a few cm about the float line sees the mean
-        # of the strut and the cylinder's secant over _SECANT_M
-        cylinder = (float(segment_area_m2(d0, hull.radius_m))
-                    - float(segment_area_m2(d0 - _SECANT_M, hull.radius_m))) / _SECANT_M
-        strip = rho_g * 0.5 * (hull.strut_width_m + cylinder) * hull.strip_length_m
+        # downwards) below it: HullSection.heave_width_m (the estimator's heave mass too)
+        strip = rho_g * hull.section.heave_width_m(_SECANT_M) * hull.strip_length_m
         k_heave = strip * hull.station_x_m.size
         k_roll = strip * float(np.sum(hull.station_y_m ** 2))
         k_pitch = strip * float(np.sum(hull.station_x_m ** 2))
@@ -119,4 +115,4 @@ class Seakeeping:
             inertia = k / (2.0 * math.pi * hz) ** 2
             out.append((inertia, 2.0 * zeta * math.sqrt(k * inertia)))
         (m3, c3), (i4, c4), (i5, c5) = out
-        return cls(m3, i4, i5, c3, c4, c5, k_heave, k_roll, k_pitch, d0)
+        return cls(m3, i4, i5, c3, c4, c5, k_heave, k_roll, k_pitch, hull.float_depth_m)
