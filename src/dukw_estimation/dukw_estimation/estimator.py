@@ -55,6 +55,9 @@ class Estimator:
         self.heave_mass_kg = buoyancy.heave_mass_kg(waterplane_m2,
                                                     body.water_density_kgpm3,
                                                     body.gravity_mps2, settings.heave_natural_hz)
+        stiffness = body.water_density_kgpm3 * body.gravity_mps2 * waterplane_m2
+        self.heave_damping_n_per_mps = 2.0 * settings.heave_damping_ratio * math.sqrt(
+            stiffness * self.heave_mass_kg)
         self.counters: dict[str, dict[Outcome, int]] = {s: defaultdict(int) for s in SENSORS}
         self.rates = {s: RateCounter() for s in SENSORS}
         self.reset()
@@ -89,6 +92,8 @@ class Estimator:
         self.fraction = 1.0
         self.afloat = False
         self.motion = 0.0                # > 1: rolling, pitching, heaving like a floating hull
+        self._heave_mean_mps2 = 0.0      # slow mean of the heave acceleration (tilt, bias)
+        self.heave_velocity_mps = 0.0
         self._fraction_t_s = -math.inf
         self._force_update_t = -math.inf
         self._grounded_since_s = math.inf
@@ -212,6 +217,7 @@ class Estimator:
         self.accel_base = self._accel_at_base_link(s, dt)
         self.imu = s
         self._update_motion(s, dt)
+        self._update_heave_velocity(dt)
         st = self.settings
         h = np.zeros(N_STATES)
         h[Idx.R] = h[Idx.BIAS] = 1.0
@@ -260,6 +266,20 @@ class Estimator:
                  + heave ** 2 / st.contact_accel_mps2 ** 2)
         alpha = min(dt / st.contact_time_constant_s, 1.0) if dt > 0.0 else 1.0
         self.motion += alpha * (level - self.motion)
+
+    def _update_heave_velocity(self, dt: float) -> None:
+        """Heave velocity from the heave acceleration: its slow mean (attitude error, bias)
+        removed, then a leaky integral (heave.velocity_time_constant_s)."""
+        imu = self.imu
+        fz = self.accel_base[2]
+        if imu is None or not math.isfinite(fz) or not 0.0 < dt <= 5 * MAX_PREDICT_STEP_S:
+            return
+        tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
+        accel = fz / max(tilt, 0.5) - self.vehicle.body.gravity_mps2
+        tau = self.settings.heave_velocity_tau_s
+        self._heave_mean_mps2 += min(dt / (4.0 * tau), 1.0) * (accel - self._heave_mean_mps2)
+        self.heave_velocity_mps += dt * (accel - self._heave_mean_mps2) \
+            - min(dt / tau, 1.0) * self.heave_velocity_mps
 
     def _update_slope(self, s: ImuSample, dt: float) -> None:
         """Low-pass the beach slope along the seaward direction from pitch and roll."""
@@ -579,9 +599,9 @@ class Estimator:
             return body.displaced_volume_m3
         tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
         heave_accel = fz / max(tilt, 0.5) - body.gravity_mps2
-        volume = buoyancy.afloat_dynamic_volume_m3(body.displacement_n, self.heave_mass_kg,
-                                                   heave_accel, body.water_density_kgpm3,
-                                                   body.gravity_mps2)
+        volume = buoyancy.afloat_dynamic_volume_m3(
+            body.displacement_n + self.heave_damping_n_per_mps * self.heave_velocity_mps,
+            self.heave_mass_kg, heave_accel, body.water_density_kgpm3, body.gravity_mps2)
         return min(max(volume, 0.0), self.max_volume_m3)
 
     def health(self, now_s: float) -> list[Health]:

@@ -99,6 +99,12 @@ class EkfSettings:
     wave_sigma_m: float = _f('wave.sigma_m', 'wave elevation sigma, ~ H1/3 / 4', 0, 2)
     heave_natural_hz: float = _f('heave.natural_frequency_hz',
                                  'heave natural frequency afloat (vehicle.md 5: 0.5731)', 0.01, 10)
+    heave_damping_ratio: float = _f('heave.damping_ratio', 'heave damping ratio afloat (the '
+                                    'damping force joins the heave acceleration in the '
+                                    'afloat volume)', 0, 2)
+    heave_velocity_tau_s: float = _f('heave.velocity_time_constant_s', 'heave velocity: '
+                                     'leaky integral of the (mean-removed) heave '
+                                     'acceleration', 0.1, 100)
     contact_rate_rps: float = _f('contact.rate_threshold_rps', 'roll/pitch rate scale above '
                                  'which the hull is taken to float (grounded: ~0)', 1e-4, 10)
     contact_accel_mps2: float = _f('contact.accel_threshold_mps2',

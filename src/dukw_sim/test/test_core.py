@@ -259,7 +259,7 @@ def test_truth_contact_weight_and_forces_agree_through_the_surf():
     assert grazed > 0          # the run does graze the sand on a track end
 
 
-def test_estimator_heave_mass_is_the_simulators():
+def test_estimator_heave_mass_and_damping_are_the_simulators():
     """One hull model: the estimator's afloat volume from the heave acceleration uses the
     heave mass the simulator's hull is calibrated to (it used the bare 0.89 m^2 waterplane,
     9 % lighter)."""
@@ -267,3 +267,5 @@ def test_estimator_heave_mass_is_the_simulators():
     sim = SimCore.from_config()
     est = build_estimator(sim.vehicle, (0.0, 0.0, 0.0))
     assert est.heave_mass_kg == pytest.approx(sim.seakeeping.heave_mass_kg, rel=1e-9)
+    assert est.heave_damping_n_per_mps == pytest.approx(
+        sim.seakeeping.heave_damping_n_per_mps, rel=1e-9)
