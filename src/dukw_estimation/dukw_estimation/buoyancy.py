@@ -194,17 +194,6 @@ def afloat_volume_m3(displacement_n: float, water_density_kgpm3: float,
     return displacement_n / (water_density_kgpm3 * gravity_mps2)
 
 
-def _wedge_volume(depth_m: float, gradient: float, radius_m: float) -> float:
-    """Volume of a semi-infinite hull whose bottom line dips linearly under the surface.
-
-    ``depth_m`` is the water depth (normal to the hull axis) over the bottom at the deep
-    end, ``gradient`` the depth gained per metre along the hull (tan of the paper's theta).
-    """
-    if depth_m <= 0.0:
-        return 0.0
-    return float(hull_volume_on_slope(depth_m / gradient, math.atan(gradient), radius_m))
-
-
 def submerged_length_m(waterline_distance_m: float, slope_rad: float, hull_clearance_m: float,
                        bow_x_m: float, stern_x_m: float, surface_m: float = 0.0,
                        heading_cos: float = 1.0) -> float:

@@ -127,3 +127,13 @@ def test_decked_line_volume_is_the_section_integrated(depth0, gradient):
                     epsabs=1e-15, epsrel=1e-12, limit=200)[0]
     assert DECKED.line_volume_m3(depth0, gradient, 1.27, -1.27) == pytest.approx(
         expected, rel=1e-6)
+
+
+@pytest.mark.parametrize('s', [2.0, 3.0, 3.5, 4.0])
+def test_grounded_volume_is_the_papers_formula_while_the_stern_is_dry(s):
+    """The section's line integral (bare cylinder) against the paper's closed form of h2."""
+    args = (s, SLOPE, 0.25, 1.27, -1.27)
+    h2 = buoyancy.submerged_length_m(*args)
+    assert 0.0 < h2 < 2.54                               # bow wet, stern dry
+    expected = 2.0 * buoyancy.hull_volume_on_slope(h2, SLOPE, R)
+    assert buoyancy.grounded_volume_m3(*args, R) == pytest.approx(expected, rel=1e-9)
