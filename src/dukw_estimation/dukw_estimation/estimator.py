@@ -259,23 +259,29 @@ class Estimator:
     def _update_motion(self, s: ImuSample, dt: float) -> None:
         """Low-pass of (roll/pitch rate, heave acceleration) over their thresholds, squared."""
         st = self.settings
-        tilt = math.cos(s.roll_rad) * math.cos(s.pitch_rad)
-        fz = self.accel_base[2]
-        heave = fz / max(tilt, 0.5) - self.vehicle.body.gravity_mps2 if math.isfinite(fz) else 0.0
+        heave = self._heave_accel_mps2()
+        heave = heave if math.isfinite(heave) else 0.0
         level = ((s.roll_rate_rps ** 2 + s.pitch_rate_rps ** 2) / st.contact_rate_rps ** 2
                  + heave ** 2 / st.contact_accel_mps2 ** 2)
         alpha = min(dt / st.contact_time_constant_s, 1.0) if dt > 0.0 else 1.0
         self.motion += alpha * (level - self.motion)
 
+    def _heave_accel_mps2(self) -> float:
+        """Vertical acceleration of base_link: the IMU's specific force over the tilt, less
+        g (NaN without an IMU sample)."""
+        imu = self.imu
+        fz = self.accel_base[2]
+        if imu is None or not math.isfinite(fz):
+            return math.nan
+        tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
+        return fz / max(tilt, 0.5) - self.vehicle.body.gravity_mps2
+
     def _update_heave_velocity(self, dt: float) -> None:
         """Heave velocity from the heave acceleration: its slow mean (attitude error, bias)
         removed, then a leaky integral (heave.velocity_time_constant_s)."""
-        imu = self.imu
-        fz = self.accel_base[2]
-        if imu is None or not math.isfinite(fz) or not 0.0 < dt <= 5 * MAX_PREDICT_STEP_S:
+        accel = self._heave_accel_mps2()
+        if not math.isfinite(accel) or not 0.0 < dt <= 5 * MAX_PREDICT_STEP_S:
             return
-        tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
-        accel = fz / max(tilt, 0.5) - self.vehicle.body.gravity_mps2
         tau = self.settings.heave_velocity_tau_s
         self._heave_mean_mps2 += min(dt / (4.0 * tau), 1.0) * (accel - self._heave_mean_mps2)
         self.heave_velocity_mps += dt * (accel - self._heave_mean_mps2) \
@@ -592,13 +598,10 @@ class Estimator:
     def _afloat_volume(self) -> float:
         """Floating: the displacement, plus what the heave acceleration says (IMU fresh)."""
         body = self.vehicle.body
-        imu = self.imu
-        fz = self.accel_base[2]
-        if imu is None or not math.isfinite(fz) or self.t_s is None \
+        heave_accel = self._heave_accel_mps2()
+        if not math.isfinite(heave_accel) or self.t_s is None \
                 or not self._fresh('imu', self.t_s):
             return body.displaced_volume_m3
-        tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
-        heave_accel = fz / max(tilt, 0.5) - body.gravity_mps2
         volume = buoyancy.afloat_dynamic_volume_m3(
             body.displacement_n + self.heave_damping_n_per_mps * self.heave_velocity_mps,
             self.heave_mass_kg, heave_accel, body.water_density_kgpm3, body.gravity_mps2)
