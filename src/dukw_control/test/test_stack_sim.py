@@ -13,6 +13,10 @@ from dukw_common.testing import NodeProcess, ros_node
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 SIM_TIME = ['--ros-args', '-p', 'use_sim_time:=true']
+#: How far out the run ends, m: the speed is judged over its last 4 s, well clear of the
+#: surf (it floats off about 7-8 m out); ending at 12 m, the slow climb out of the last
+#: grazes could still be in the window (a 0.66 m/s mean in one CI run).
+OUT_M = 14.0
 
 
 def test_sand_to_sea_on_a_cmd_vel_of_1_mps():
@@ -31,12 +35,12 @@ def test_sand_to_sea_on_a_cmd_vel_of_1_mps():
                  NodeProcess('dukw_control', 'drive_controller_node', SIM_TIME)]
         try:
             deadline = time.monotonic() + 150.0
-            while time.monotonic() < deadline and not (truths and truths[-1].x_m > 12.0):
+            while time.monotonic() < deadline and not (truths and truths[-1].x_m > OUT_M):
                 executor.spin_once(timeout_sec=0.05)
         finally:
             codes = [p.stop() for p in procs]
     errors = '\n'.join(p.stderr[-2000:] for p in procs)
-    assert truths and truths[-1].x_m > 12.0, errors
+    assert truths and truths[-1].x_m > OUT_M, errors
     assert codes == [0, 0, 0, 0], errors
     # SAFE_STOP while the EKF starts (and, on a loaded machine, when one of its messages
     # comes late) is the manager doing its job; the driving modes must come once each
