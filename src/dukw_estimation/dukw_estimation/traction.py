@@ -73,6 +73,24 @@ def tractive_force_n(slip_: ArrayLike, effective_weight_n: ArrayLike, soil: Soil
     return float(out) if out.ndim == 0 else out
 
 
+def track_force_n(track_speed_mps: ArrayLike, ground_speed_mps: ArrayLike,
+                  effective_weight_n: ArrayLike, soil: SoilParams, contact_area_m2: float,
+                  contact_length_m: float) -> ArrayLike:
+    """Soil force on the vehicle from a track at ``track_speed_mps`` over the ground at
+    ``ground_speed_mps``, N (+ forward).
+
+    The Wong force is signed like the slip, which is relative to the track's own direction;
+    a track running backwards pushes backwards, so the force on the vehicle is that force
+    times the sign of the track speed (a stopped track counts as forward: it brakes a
+    vehicle moving forward, and pushes one moving backward forward).
+    """
+    v_t = np.asarray(track_speed_mps, dtype=float)
+    h = tractive_force_n(slip(v_t, ground_speed_mps), effective_weight_n, soil,
+                         contact_area_m2, contact_length_m)
+    out = np.where(v_t >= 0.0, h, -h)
+    return float(out) if out.ndim == 0 else out
+
+
 def effective_weight_n(displacement_n: float, submerged_volume_m3: ArrayLike,
                        slope_rad: ArrayLike, water_density_kgpm3: float,
                        gravity_mps2: float) -> ArrayLike:

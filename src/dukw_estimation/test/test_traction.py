@@ -80,3 +80,16 @@ def test_force_never_exceeds_strength(i, w, k):
     force = traction.tractive_force_n(i, w, soil, A, L)
     assert math.isfinite(force)
     assert abs(force) <= traction.max_traction_n(w, soil, A) + 1e-9
+
+
+def test_track_force_on_the_vehicle_follows_the_belt_against_the_ground():
+    """Forward drive pushes forward, reverse drive backward; a stopped track brakes a vehicle
+    rolling either way (the model's force is signed like the slip, relative to the track)."""
+    w, a, l_m = 1400.0, 0.088, 1.07
+    forward = traction.track_force_n(1.0, 0.8, w, SOIL, a, l_m)
+    reverse = traction.track_force_n(-1.0, -0.8, w, SOIL, a, l_m)
+    assert forward > 0.0 and reverse == pytest.approx(-forward)
+    assert traction.track_force_n(0.0, 0.5, w, SOIL, a, l_m) < 0.0      # braking, rolling on
+    assert traction.track_force_n(0.0, -0.5, w, SOIL, a, l_m) > 0.0     # braking, rolling back
+    vec = traction.track_force_n(np.array([1.0, -1.0]), np.array([0.8, -0.8]), w, SOIL, a, l_m)
+    assert vec.tolist() == pytest.approx([forward, -forward])

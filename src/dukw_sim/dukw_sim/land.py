@@ -8,9 +8,8 @@ slip and its share of the effective weight. When the force the soil would take a
 commanded speed exceeds what the motor can give, the track slows until the two balance
 (the stall on 19 deg: "without track slip" on firm sand).
 
-The shared model's force is signed like the slip, which is relative to the track's
-own direction; a track running backwards pushes backwards, so the force on the vehicle
-is the model's force times the sign of the track speed.
+The force on the vehicle (a track running backwards pushes backwards) is the shared
+``traction.track_force_n``.
 """
 from __future__ import annotations
 
@@ -36,10 +35,8 @@ class TrackContact:
 
     def forces_n(self, track_mps: np.ndarray, ground_mps: np.ndarray) -> np.ndarray:
         """Force on the vehicle from tracks at ``track_mps`` over ground speeds, N (+ forward)."""
-        i = traction.slip(track_mps, ground_mps)
-        h = traction.tractive_force_n(i, self.weight_per_track_n, self.soil, self.area_m2,
-                                      self.length_m)
-        return np.where(np.asarray(track_mps) >= 0.0, h, -h)
+        return np.asarray(traction.track_force_n(track_mps, ground_mps, self.weight_per_track_n,
+                                                 self.soil, self.area_m2, self.length_m))
 
 
 @dataclass
