@@ -77,12 +77,20 @@ class DrivetrainParams:
     continuous_current_limit_a: float
     motor_voltage_v: float
     no_load_current_a: float
+    friction_n: float                # belt friction per track beyond the no-load current
+    port_extra_friction_n: float     # the port track's extra friction (the 4 % port bias)
     sprocket_diameter_m: float
     gear_reduction: float
     max_prop_thrust_n: float
     prop_reverse_thrust_ratio: float
     port_bias_pct: float
     max_differential_ratio: float
+
+    def track_friction_n(self, port: bool) -> float:
+        """Drivetrain friction one track's motor overcomes besides the soil, N: the no-load
+        current's share plus the belt's friction (the port track's extra included)."""
+        return (self.no_load_current_a * self.track_force_gain_n_per_a + self.friction_n
+                + (self.port_extra_friction_n if port else 0.0))
 
 
 @dataclass(frozen=True)

@@ -124,7 +124,7 @@ class SimCore:
         self._kg = body.kg_m
         self._max_motor_n = drive.track_force_gain_n_per_a * (
             land.max_current_a - drive.no_load_current_a)
-        self._port_droop_mps = land.port_extra_friction_n / land.speed_loop_stiffness_n_per_mps
+        self._port_droop_mps = drive.port_extra_friction_n / land.speed_loop_stiffness_n_per_mps
         self._wet_soil = _soil_with_floor(vehicle.soil, land.min_shear_modulus_m)
         dry = params.dry_soil or vehicle.soil
         self._dry_soil = _soil_with_floor(dry, land.min_shear_modulus_m)
@@ -312,6 +312,7 @@ class SimCore:
 
         # --- track drives
         land = p.land
+        drive = veh.drivetrain
         full = veh.drivetrain.full_scale_track_speed_mps
         targets = [act.port_track_pct / 100.0 * full, act.stbd_track_pct / 100.0 * full]
         if targets[0] != 0.0:
@@ -325,7 +326,7 @@ class SimCore:
         others = []
         paddle = []
         for i in range(2):
-            fric = land.drivetrain_friction_n + (land.port_extra_friction_n if i == 0 else 0.0)
+            fric = drive.friction_n + (drive.port_extra_friction_n if i == 0 else 0.0)
             ts = self.track_speed[i]
             if abs(ts) < _BREAKAWAY_MPS:
                 fric *= 1.0 + (land.breakaway_friction_ratio - 1.0) * (

@@ -73,8 +73,6 @@ class LandParams:
     speed_loop_time_constant_s: float
     speed_loop_accel_mps2: float
     speed_loop_stiffness_n_per_mps: float
-    drivetrain_friction_n: float
-    port_extra_friction_n: float
     breakaway_friction_ratio: float
     rolling_resistance_coeff: float
     lateral_friction_coeff: float

@@ -146,7 +146,7 @@ def test_motor_current_is_force_over_gain_plus_no_load():
     motor_force = (truth.stbd_current_a - drive.no_load_current_a) \
         * drive.track_force_gain_n_per_a
     # the motor carries the soil force plus the drivetrain friction
-    assert motor_force == pytest.approx(truth.stbd_force_n + sim.params.land.drivetrain_friction_n,
+    assert motor_force == pytest.approx(truth.stbd_force_n + drive.friction_n,
                                         rel=0.02)
     assert truth.battery_voltage_v < drive.motor_voltage_v
 
