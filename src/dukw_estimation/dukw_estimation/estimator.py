@@ -436,9 +436,11 @@ class Estimator:
 
     def _track_force_update(self, s: DriveStatus) -> None:
         """The smoothed track forces against the Wong force of the estimated weight: a
-        measurement of the surface (vehicle.md 6), where both tracks slip enough for the
-        force to depend on the weight, the vehicle has lain on the sand a while (the
-        smoother lags a touchdown) and the weight is not all on the tracks or all afloat."""
+        measurement of the surface (vehicle.md 6), where both tracks turn and slip enough for
+        the force to depend on the weight (a stopped or gripping track takes whatever force
+        holds it), the vehicle has lain on the sand a moment (the smoother lags a touchdown)
+        and the weight is not all on the tracks or all afloat. The ground speed's uncertainty
+        joins the force noise through the slip."""
         st = self.settings
         if self.afloat:
             self._grounded_since_s = math.inf
@@ -448,34 +450,60 @@ class Estimator:
                 or s.t_s - self._grounded_since_s < st.force_update_settle_s \
                 or s.t_s - self._force_update_t < st.force_update_period_s:
             return
-        self._force_update_t = s.t_s
-        x = self.ekf.x
         speeds = (s.port.speed_mps, s.stbd.speed_mps)
         ground = self._ground_speeds()
         slips = [float(traction.slip(speeds[k], ground[k])) for k in range(2)]
-        if not all(abs(i) >= st.force_update_min_slip for i in slips):
+        if not all(abs(speeds[k]) >= st.force_update_min_track_speed_mps
+                   and abs(slips[k]) >= st.force_update_min_slip for k in range(2)):
             return
-        # the drivetrain's own friction (the no-load current) opposes the belt, not the sand
-        friction = self.vehicle.drivetrain.no_load_current_a \
-            * self.vehicle.drivetrain.track_force_gain_n_per_a
-        measured = [self.force[k].force_n - math.copysign(friction, speeds[k])
-                    for k in range(2)]
+        # the drivetrain's own friction (no-load current, belt) opposes the belt, not the sand
+        drive = self.vehicle.drivetrain
+        measured = [self.force[k].force_n - math.copysign(drive.track_friction_n(k == 0),
+                                                          speeds[k]) for k in range(2)]
         if not all(math.isfinite(m) for m in measured):
             return
-        slope = self.slope_rad
-        sin_t = math.sin(slope)
-        step_m = 0.005
+        self._force_update_t = s.t_s
+        x, P = self.ekf.x, self.ekf.P
+        sin_t = math.sin(self.slope_rad)
+        half = 0.5 * self.vehicle.body.hull_separation_m
+        step_mps = 0.01
         for k in range(2):
-            predicted = self._soil_force_n(x[Idx.S], x[Idx.ETA], slips[k])
-            per_m = (self._soil_force_n(x[Idx.S], x[Idx.ETA] + step_m, slips[k])
-                     - predicted) / step_m
-            if abs(per_m) < 1e-3:
-                continue                 # all weight on the tracks, or none: no news
+            lever = -half if k == 0 else half
+            predicted = self._soil_force_n(x[Idx.S], x[Idx.ETA], speeds[k], ground[k])
+            per_m = self._force_per_m(predicted, measured[k], speeds[k], ground[k])
+            if per_m is None:
+                continue                 # the surface cannot explain the difference
+            per_mps = (self._soil_force_n(x[Idx.S], x[Idx.ETA], speeds[k], ground[k] + step_mps)
+                       - predicted) / step_mps
+            ground_var = P[Idx.U, Idx.U] + lever * lever * P[Idx.R, Idx.R] \
+                + 2.0 * lever * P[Idx.U, Idx.R]
             h = np.zeros(N_STATES)
             h[Idx.ETA] = per_m
             h[Idx.S] = per_m * sin_t     # the volume follows the water depth eta + s sin
-            self.ekf.update_scalar(measured[k], predicted, h, st.force_update_sigma_n ** 2,
-                                   st.force_update_gate, only=SURFACE_STATES)
+            var = st.force_update_sigma_n ** 2 + per_mps * per_mps * max(ground_var, 0.0)
+            self.ekf.update_scalar(measured[k], predicted, h, var, st.force_update_gate,
+                                   only=SURFACE_STATES)
+
+    def _force_per_m(self, predicted_n: float, measured_n: float, track_mps: float,
+                     ground_mps: float) -> float | None:
+        """d force / d surface, N/m; None where the surface cannot change the force.
+
+        Where the estimate puts no weight on the tracks (the volume capped at the
+        displacement) the local derivative is nil, and a track clearly pushing under a hull
+        thought afloat would be ignored: when the force asks for less water, the secant over
+        the first of growing steps down that changes the force is used instead. On dry
+        sand (all the weight on the tracks) a force short of the model's says more about the
+        soil than about water, and only the local derivative counts.
+        """
+        x = self.ekf.x
+        steps = (0.005,) if measured_n <= predicted_n else (0.005, 0.02, 0.05, 0.1, 0.2)
+        direction = 1.0 if measured_n <= predicted_n else -1.0
+        for step_m in steps:
+            moved = self._soil_force_n(x[Idx.S], x[Idx.ETA] + direction * step_m, track_mps,
+                                       ground_mps)
+            if abs(moved - predicted_n) > 1e-3:
+                return (moved - predicted_n) / (direction * step_m)
+        return None
 
     def _ground_speeds(self) -> tuple[float, float]:
         """Ground speed under the port and starboard tracks, m/s."""
@@ -484,8 +512,9 @@ class Estimator:
         return x[Idx.U] - x[Idx.R] * half, x[Idx.U] + x[Idx.R] * half
 
     def _soil_force_n(self, waterline_distance_m: float, surface_m: float,
-                      slip_: float) -> float:
-        """Wong force of one track at this slip, with the weight the surface leaves it, N."""
+                      track_mps: float, ground_mps: float) -> float:
+        """Soil force on the vehicle from one track at these speeds, with the weight the
+        surface leaves it, N."""
         body = self.vehicle.body
         heading_cos = math.cos(self.ekf.x[Idx.YAW] - self.settings.seaward_yaw_rad)
         volume = buoyancy.grounded_volume_m3(waterline_distance_m, self.slope_rad,
@@ -496,9 +525,8 @@ class Estimator:
                                              min(volume, body.displaced_volume_m3),
                                              self.slope_rad, body.water_density_kgpm3,
                                              body.gravity_mps2)
-        return float(traction.tractive_force_n(slip_, 0.5 * weight, self.soil,
-                                               self.track_area_m2,
-                                               body.track_contact_length_m))
+        return float(traction.track_force_n(track_mps, ground_mps, 0.5 * weight, self.soil,
+                                            self.track_area_m2, body.track_contact_length_m))
 
     def _track_odometry(self, s: DriveStatus) -> None:
         """GPS velocity stale on land: the tracks say roughly how fast we go."""
@@ -566,9 +594,9 @@ class Estimator:
             speeds = (self.tracks.port.speed_mps, self.tracks.stbd.speed_mps)
             for k in range(2):
                 slips[k] = traction.slip(speeds[k], ground[k])
-                predicted[k] = traction.tractive_force_n(slips[k], 0.5 * weight, self.soil,
-                                                         self.track_area_m2,
-                                                         body.track_contact_length_m)
+                predicted[k] = traction.track_force_n(speeds[k], ground[k], 0.5 * weight,
+                                                      self.soil, self.track_area_m2,
+                                                      body.track_contact_length_m)
         return TractionEstimate(self.t_s or 0.0, slips[0], slips[1], volume, weight,
                                 self.fraction, float(x[Idx.S]), h2, slope, predicted[0],
                                 predicted[1], self.force[0].force_n, self.force[1].force_n,
@@ -583,6 +611,8 @@ class Estimator:
         acceleration); floating, it rolls, pitches and heaves with the waves.
         """
         displaced = self.vehicle.body.displaced_volume_m3
+        if self._tracks_pushing():
+            return False
         limit = displaced * (TOUCHDOWN_SHARE if self.afloat else 1.0)
         imu_fresh = self.imu is not None and self.t_s is not None and self._fresh('imu', self.t_s)
         if grounded_volume_m3 >= limit:
@@ -594,6 +624,24 @@ class Estimator:
             return self.motion > 1.0 and \
                 grounded_volume_m3 >= self.settings.contact_min_volume_share * displaced
         return False
+
+    def _tracks_pushing(self) -> bool:
+        """Both tracks turn and push (brake) the vehicle harder than paddling could: on the
+        sand. From the smoothed forces less the drivetrain friction, fresh status only."""
+        st = self.settings
+        s = self.tracks
+        if st.contact_track_force_n <= 0.0 or s is None or self.t_s is None \
+                or not self._fresh('tracks', self.t_s):
+            return False
+        drive = self.vehicle.drivetrain
+        for k, side in enumerate((s.port, s.stbd)):
+            speed = side.speed_mps
+            if abs(speed) < st.force_update_min_track_speed_mps:
+                return False
+            soil = self.force[k].force_n - math.copysign(drive.track_friction_n(k == 0), speed)
+            if not abs(soil) >= st.contact_track_force_n:
+                return False
+        return True
 
     def _afloat_volume(self) -> float:
         """Floating: the displacement, plus what the heave acceleration says (IMU fresh)."""

@@ -114,6 +114,10 @@ class EkfSettings:
     contact_min_volume_share: float = _f('contact.min_volume_share',
                                          'floating needs at least this share of the '
                                          'displacement under water (bumps on land)', 0, 1)
+    contact_track_force_n: float = _f('contact.track_force_n', 'both turning tracks pushing '
+                                      'this hard past their friction touch the sand, whatever '
+                                      'the IMU says (paddling afloat pushes less; 0: off)',
+                                      0, 1e4)
     gps_bias_sigma_m: float = _f('gps_bias.sigma_m', 'slowly drifting DGPS position error '
                                  'sigma (0: no bias states, message covariance used)', 0, 100)
     gps_bias_tau_s: float = _f('gps_bias.tau_s', 'correlation time of the DGPS error', 0.01,
@@ -136,6 +140,9 @@ class EkfSettings:
     # the measured track forces as a measurement of the weight on the tracks
     force_update_min_slip: float = _f('force_update.min_slip', 'both tracks slipping at least '
                                       'this much: the Wong force then tells the weight', 0, 1)
+    force_update_min_track_speed_mps: float = _f(
+        'force_update.min_track_speed_mps', 'both tracks turning at least this fast (the slip '
+        'of a nearly stopped track is the ground speed error over its speed)', 0, 10)
     force_update_sigma_n: float = _f('force_update.sigma_n', 'per track: current noise, '
                                      'unmodelled friction and paddle thrust (0: off)', 0, 1e4)
     force_update_period_s: float = _f('force_update.period_s', 'at most this often (the '

@@ -268,7 +268,7 @@ def test_lying_still_in_a_trough_is_on_the_sand_though_the_mean_surface_would_fl
     assert out.weight_on_tracks_fraction > 0.05
 
 
-def _surf_run(est, true_surface_m, slip_, seconds=5.0, x0=5.0):
+def _surf_run(est, true_surface_m, slip_, seconds=5.0, x0=5.0, track_mps=0.5):
     """Crawl seaward on the slope with both tracks slipping by slip_, under a surface
     true_surface_m off the mean; the track forces are the Wong forces of the true weight."""
     from dukw_estimation import buoyancy
@@ -276,7 +276,6 @@ def _surf_run(est, true_surface_m, slip_, seconds=5.0, x0=5.0):
     body, drive = VEHICLE.body, VEHICLE.drivetrain
     section = buoyancy.HullSection.of_body(body)
     soil = soil_params(PARAMS)
-    track_mps = 0.3
     u = track_mps * (1.0 - slip_)
     x, t, fraction = x0, 0.0, math.nan
     for k in range(int(round(seconds / 0.01))):
@@ -294,11 +293,14 @@ def _surf_run(est, true_surface_m, slip_, seconds=5.0, x0=5.0):
             est.add_gps_fix(fix(t, x, 0.0))
             est.add_gps_velocity(GpsVelocity(t, u * math.cos(slope), 0.0))
         if k % 5 == 0:
-            force = traction.tractive_force_n(slip_, 0.5 * weight, soil, est.track_area_m2,
-                                              body.track_contact_length_m) \
-                + drive.no_load_current_a * drive.track_force_gain_n_per_a
-            side = MotorSide(30.0, force / drive.track_force_gain_n_per_a, track_mps, force)
-            est.add_tracks(DriveStatus(t, side, side))
+            soil_n = traction.tractive_force_n(slip_, 0.5 * weight, soil, est.track_area_m2,
+                                               body.track_contact_length_m)
+            sides = []
+            for port in (True, False):    # the motors also turn the drivetrain
+                force = soil_n + drive.track_friction_n(port)
+                sides.append(MotorSide(30.0, force / drive.track_force_gain_n_per_a,
+                                       track_mps, force))
+            est.add_tracks(DriveStatus(t, *sides))
     return fraction
 
 
@@ -316,11 +318,53 @@ def test_slipping_track_forces_tell_the_weight_the_surface_leaves_on_the_tracks(
 
 def test_track_forces_are_not_used_at_low_slip():
     quiet = make(wave_sigma_m=0.07, waterline_sigma_m=0.05)
-    _surf_run(quiet, -0.06, 0.05)
+    _surf_run(quiet, -0.06, 0.02)
     deaf = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, force_update_sigma_n=0.0)
-    _surf_run(deaf, -0.06, 0.05)
+    _surf_run(deaf, -0.06, 0.02)
     assert quiet.traction().weight_on_tracks_fraction == pytest.approx(
         deaf.traction().weight_on_tracks_fraction, abs=1e-9)
+
+
+def test_track_forces_of_nearly_stopped_tracks_are_not_used():
+    """Crawling at 0.1 m/s the slip is the ground-speed error over the track speed: no news."""
+    slow = make(wave_sigma_m=0.07, waterline_sigma_m=0.05)
+    _surf_run(slow, -0.06, 0.4, seconds=1.0, track_mps=0.1)
+    assert slow._force_update_t == -math.inf              # never used
+    turning = make(wave_sigma_m=0.07, waterline_sigma_m=0.05)
+    _surf_run(turning, -0.06, 0.4, seconds=1.0, track_mps=0.5)
+    assert turning._force_update_t > 0.5
+
+
+def test_tracks_pushing_under_a_hull_thought_afloat_bring_the_weight_back():
+    """The estimate starts with the surface 20 cm too high (the volume capped at the
+    displacement: no weight on the tracks, the force's local derivative nil); the slipping
+    tracks push with the true weight on them, and the estimate follows."""
+    est = make(wave_sigma_m=0.07, waterline_sigma_m=0.05)
+    est.ekf.x[Idx.ETA] = 0.2
+    truth = _surf_run(est, 0.0, 0.4, seconds=0.3, x0=4.0)
+    assert 0.2 < truth < 0.9
+    pinned = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, force_update_sigma_n=0.0)
+    pinned.ekf.x[Idx.ETA] = 0.2
+    _surf_run(pinned, 0.0, 0.4, seconds=0.3, x0=4.0)
+    assert pinned.traction().weight_on_tracks_fraction < 0.05     # without the forces
+    assert est.traction().weight_on_tracks_fraction == pytest.approx(truth, abs=0.15)
+
+
+def test_both_tracks_pushing_hard_mean_the_sand_even_when_the_imu_rolls():
+    est = make()
+    est.motion = 5.0                     # the IMU's motion test says: floating
+    est.t_s = 1.0
+    est.last_t['tracks'] = 1.0
+    est.tracks = tracks(1.0, 1.0, 1.0)
+    drive = VEHICLE.drivetrain
+    for k, smoother in enumerate(est.force):
+        smoother.update(1.0, drive.track_friction_n(k == 0) + 200.0)
+    assert est._tracks_pushing()
+    assert not est._floating(VEHICLE.body.displaced_volume_m3 * 1.1)
+    for k, smoother in enumerate(est.force):     # paddling: the friction and a little more
+        smoother.kf.x[0, 0] = drive.track_friction_n(k == 0) + 20.0
+    assert not est._tracks_pushing()
+    assert est._floating(VEHICLE.body.displaced_volume_m3 * 1.1)
 
 
 def _heaving_afloat(est, seconds=12.0, amplitude_m=0.1, hz=0.3):

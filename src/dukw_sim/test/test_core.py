@@ -148,6 +148,11 @@ def test_motor_current_is_force_over_gain_plus_no_load():
     # the motor carries the soil force plus the drivetrain friction
     assert motor_force == pytest.approx(truth.stbd_force_n + drive.friction_n,
                                         rel=0.02)
+    # current x gain less the soil force: the friction the EKF takes off (port: its extra)
+    for current, soil, port in ((truth.port_current_a, truth.port_force_n, True),
+                                (truth.stbd_current_a, truth.stbd_force_n, False)):
+        assert current * drive.track_force_gain_n_per_a - soil == pytest.approx(
+            drive.track_friction_n(port), rel=0.03)
     assert truth.battery_voltage_v < drive.motor_voltage_v
 
 
