@@ -29,6 +29,7 @@ GROUNDED_FRACTION = 0.5          # above this weight share the tracks drive the 
 SLOPE_FRACTION = 0.9             # above this share the pitch is the beach's, not the waves'
 TOUCHDOWN_SHARE = 0.8           # afloat until the mean-surface volume drops below this share
 FRACTION_PERIOD_S = 0.1          # how often the IMU path refreshes the weight share
+FRICTION_SPEED_MPS = 0.1         # the drivetrain friction builds up over this belt speed
 
 
 class Estimator:
@@ -456,10 +457,7 @@ class Estimator:
         if not all(abs(speeds[k]) >= st.force_update_min_track_speed_mps
                    and abs(slips[k]) >= st.force_update_min_slip for k in range(2)):
             return
-        # the drivetrain's own friction (no-load current, belt) opposes the belt, not the sand
-        drive = self.vehicle.drivetrain
-        measured = [self.force[k].force_n - math.copysign(drive.track_friction_n(k == 0),
-                                                          speeds[k]) for k in range(2)]
+        measured = [self._measured_soil_force_n(k) for k in range(2)]
         if not all(math.isfinite(m) for m in measured):
             return
         self._force_update_t = s.t_s
@@ -599,7 +597,8 @@ class Estimator:
                                                       body.track_contact_length_m)
         return TractionEstimate(self.t_s or 0.0, slips[0], slips[1], volume, weight,
                                 self.fraction, float(x[Idx.S]), h2, slope, predicted[0],
-                                predicted[1], self.force[0].force_n, self.force[1].force_n,
+                                predicted[1], self._measured_soil_force_n(0),
+                                self._measured_soil_force_n(1),
                                 afloat, float(x[Idx.ETA]))
 
     def _floating(self, grounded_volume_m3: float) -> bool:
@@ -633,15 +632,24 @@ class Estimator:
         if st.contact_track_force_n <= 0.0 or s is None or self.t_s is None \
                 or not self._fresh('tracks', self.t_s):
             return False
-        drive = self.vehicle.drivetrain
         for k, side in enumerate((s.port, s.stbd)):
-            speed = side.speed_mps
-            if abs(speed) < st.force_update_min_track_speed_mps:
+            if abs(side.speed_mps) < st.force_update_min_track_speed_mps:
                 return False
-            soil = self.force[k].force_n - math.copysign(drive.track_friction_n(k == 0), speed)
-            if not abs(soil) >= st.contact_track_force_n:
+            if not abs(self._measured_soil_force_n(k)) >= st.contact_track_force_n:
                 return False
         return True
+
+    def _measured_soil_force_n(self, k: int) -> float:
+        """Track k's (0 port, 1 starboard) smoothed current x gain less the drivetrain's own
+        friction (no-load current, belt), which opposes the belt, not the sand: the soil's
+        force, N (NaN before a status). The friction fades in over the first 0.1 m/s of belt
+        speed, as a stopped belt's does."""
+        force = self.force[k].force_n
+        if self.tracks is None or not math.isfinite(force):
+            return math.nan
+        speed = (self.tracks.port, self.tracks.stbd)[k].speed_mps
+        friction = self.vehicle.drivetrain.track_friction_n(k == 0)
+        return force - friction * math.tanh(speed / FRICTION_SPEED_MPS)
 
     def _afloat_volume(self) -> float:
         """Floating: the displacement, plus what the heave acceleration says (IMU fresh)."""

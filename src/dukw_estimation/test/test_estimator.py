@@ -128,7 +128,11 @@ def test_on_dry_land_all_weight_on_tracks_and_force_prediction_matches_the_model
                                          body.track_width_m * body.track_contact_length_m,
                                          body.track_contact_length_m)
     assert out.port_force_predicted_n == pytest.approx(expected)
-    assert out.port_force_measured_n == pytest.approx(100.0)
+    drive = VEHICLE.drivetrain            # 100 N of current x gain, less the friction
+    assert out.port_force_measured_n == pytest.approx(100.0 - drive.track_friction_n(True),
+                                                      abs=0.5)
+    assert out.stbd_force_measured_n == pytest.approx(100.0 - drive.track_friction_n(False),
+                                                      abs=0.5)
 
 
 def test_nan_out_of_order_and_outliers_are_rejected_counted_and_change_nothing():
