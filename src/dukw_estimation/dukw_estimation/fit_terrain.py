@@ -1,7 +1,8 @@
 """fit_terrain BAG: fit the soil's c, phi, k to the track forces in a recorded rosbag2.
 
 The paper's method (vehicle.md section 6, its Table XIII): least squares of the modified
-Wong model H(i, W_e; c, phi, k) to the measured (Kalman-smoothed) track forces, with the
+Wong model H(i, W_e; c, phi, k) to the measured track forces (current x gain,
+Kalman-smoothed, less the drivetrain friction: the soil's share), with the
 slip and effective weight the estimator published on ``traction`` (dukw_msgs/Traction).
 Prints each parameter with its standard deviation (from the Jacobian at the solution) and
 the residual; refuses when the slip hardly varies (then c, phi and k cannot be told apart).
@@ -30,6 +31,9 @@ MIN_SAMPLES = 20
 #: Bounds of (cohesion Pa, friction angle rad, shear modulus m).
 LOWER = np.array([0.0, 0.0, 1e-4])
 UPPER = np.array([2e4, 1.2, 0.5])
+#: Condition number of the scaled normal matrix beyond which the fit is refused (a good
+#: fit is ~1e3; c and phi on a constant weight are collinear, ~1e16).
+MAX_CONDITION = 1e8
 
 
 class FitError(ValueError):
@@ -96,11 +100,20 @@ def fit_soil(samples: TractionSamples, contact_area_m2: float, contact_length_m:
     result = least_squares(residuals, x0, bounds=(LOWER, UPPER), x_scale=scale)
     dof = max(slip.size - 3, 1)
     s2 = float(np.sum(result.fun ** 2)) / dof
+    scaled = result.jac * scale
     try:
         cov = np.linalg.inv(result.jac.T @ result.jac) * s2
         sigma = tuple(float(math.sqrt(max(v, 0.0))) for v in np.diag(cov))
     except np.linalg.LinAlgError:
         sigma = (math.inf, math.inf, math.inf)
+    if not all(math.isfinite(v) for v in sigma) \
+            or not np.linalg.cond(scaled.T @ scaled) < MAX_CONDITION:
+        spread = float(np.ptp(weight))
+        raise FitError('the samples do not determine c, phi and k (singular fit, residual '
+                       f'{math.sqrt(np.mean(result.fun ** 2)):.0f} N): c and phi need the '
+                       f'weight on the tracks to vary (it spans {spread:.0f} N here), k needs '
+                       'slips on the rising part of the curve. Record straight runs at '
+                       'several commands and across the transition.')
     p = result.x
     return SoilFit(SoilParams(float(p[0]), float(p[1]), float(p[2])), sigma,
                    float(math.sqrt(np.mean(result.fun ** 2))), int(slip.size))

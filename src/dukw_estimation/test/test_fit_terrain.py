@@ -70,6 +70,16 @@ def test_refuses_a_bag_with_flat_slip(tmp_path, capsys):
     assert 'slip hardly varies' in err
 
 
+def test_refuses_a_bag_whose_weight_never_changes(tmp_path, capsys):
+    """Slip varies but the weight does not: A c + W tan(phi) is one number, c and phi are
+    not separately determined - refused, not printed as a fit."""
+    n = 300
+    bag = write_bag(tmp_path / 'dry', np.linspace(0.01, 0.8, n), np.full(n, 2894.0))
+    assert fit_terrain.main([str(bag)]) == 1
+    err = capsys.readouterr().err
+    assert 'do not determine c, phi and k' in err and 'weight on the tracks to vary' in err
+
+
 def test_refuses_what_is_not_a_bag(tmp_path, capsys):
     assert fit_terrain.main([str(tmp_path)]) == 1
     assert 'not a rosbag2 folder' in capsys.readouterr().err
