@@ -8,6 +8,7 @@ Prints each parameter with its standard deviation (from the Jacobian at the solu
 the residual; refuses when the slip hardly varies (then c, phi and k cannot be told apart).
 
     install/lib/dukw_estimation/fit_terrain BAG [--topic traction] [--min-slip-spread 0.05]
+                                            [--slip-range 0.05 0.95]
 """
 from __future__ import annotations
 
@@ -34,6 +35,8 @@ UPPER = np.array([2e4, 1.2, 0.5])
 #: Condition number of the scaled normal matrix beyond which the fit is refused (a good
 #: fit is ~1e3; c and phi on a constant weight are collinear, ~1e16).
 MAX_CONDITION = 1e8
+#: |slip| used by default: past the grip regime, short of the clipped slip of a stopped track.
+SLIP_RANGE = (0.05, 0.95)
 
 
 class FitError(ValueError):
@@ -74,14 +77,22 @@ class SoilFit:
 
 
 def fit_soil(samples: TractionSamples, contact_area_m2: float, contact_length_m: float,
-             min_slip_spread: float = 0.05, initial: SoilParams | None = None) -> SoilFit:
-    """Least-squares c, phi, k; FitError when the data cannot identify them."""
+             min_slip_spread: float = 0.05, initial: SoilParams | None = None,
+             slip_range: tuple[float, float] = SLIP_RANGE) -> SoilFit:
+    """Least-squares c, phi, k; FitError when the data cannot identify them.
+
+    Only samples with |slip| within ``slip_range`` are used: below it the tracks grip and
+    the force is whatever holds them (static friction, not the Wong curve); at the top the
+    slip is clipped (a stopped track under a moving vehicle).
+    """
+    lo_slip, hi_slip = slip_range
     ok = (np.isfinite(samples.slip) & np.isfinite(samples.weight_n) & np.isfinite(samples.force_n)
-          & (samples.weight_n > 0.0))
+          & (samples.weight_n > 0.0) & (np.abs(samples.slip) >= lo_slip)
+          & (np.abs(samples.slip) <= hi_slip))
     slip, weight, force = samples.slip[ok], samples.weight_n[ok], samples.force_n[ok]
     if slip.size < MIN_SAMPLES:
-        raise FitError(f'only {slip.size} usable samples (tracks on the ground, finite values); '
-                       f'need at least {MIN_SAMPLES}')
+        raise FitError(f'only {slip.size} usable samples (tracks on the ground, finite values, '
+                       f'|slip| {lo_slip:g}-{hi_slip:g}); need at least {MIN_SAMPLES}')
     lo, hi = np.percentile(np.abs(slip), [5, 95])
     if hi - lo < min_slip_spread:
         raise FitError(f'the slip hardly varies (|i| from {lo:.3f} to {hi:.3f}, 5-95 %, spread '
@@ -166,6 +177,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument('--topic', default='traction', help='traction topic (default: traction)')
     parser.add_argument('--min-slip-spread', type=float, default=0.05,
                         help='refuse when the 5-95 %% range of |slip| is narrower (default 0.05)')
+    parser.add_argument('--slip-range', type=float, nargs=2, default=SLIP_RANGE,
+                        metavar=('MIN', 'MAX'), help='|slip| of the samples used (default '
+                        f'{SLIP_RANGE[0]} {SLIP_RANGE[1]}: not gripping, not a stopped track)')
     parser.add_argument('--config', help="parameter file (default: the stack's)")
     args = parser.parse_args(argv)
     try:
@@ -173,7 +187,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         body = vehicle.body
         samples = read_samples(args.bag, args.topic)
         fit = fit_soil(samples, body.track_width_m * body.track_contact_length_m,
-                       body.track_contact_length_m, args.min_slip_spread, vehicle.soil)
+                       body.track_contact_length_m, args.min_slip_spread, vehicle.soil,
+                       tuple(args.slip_range))
     except FitError as exc:
         print(f'fit_terrain: refused: {exc}', file=sys.stderr)
         return 1

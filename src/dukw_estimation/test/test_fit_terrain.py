@@ -1,5 +1,6 @@
 """fit_terrain on bags written here with rosbags from a known soil plus noise."""
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -78,6 +79,27 @@ def test_refuses_a_bag_whose_weight_never_changes(tmp_path, capsys):
     assert fit_terrain.main([str(bag)]) == 1
     err = capsys.readouterr().err
     assert 'do not determine c, phi and k' in err and 'weight on the tracks to vary' in err
+
+
+def test_recovers_the_simulated_beach_from_a_recorded_surf_run(capsys):
+    """The golden sea-to-land bag (simulator on the beach_72 soil, the EKF's traction as
+    recorded, scripts/make_golden.sh): within the fit's own uncertainty of the truth."""
+    bag = Path(__file__).resolve().parents[3] / 'tests' / 'golden' / 'sea_to_land'
+    assert fit_terrain.main([str(bag)]) == 0
+    assert 'residual rms' in capsys.readouterr().out
+    fit = fit_terrain.fit_soil(fit_terrain.read_samples(bag), AREA,
+                               BODY.track_contact_length_m, initial=VEHICLE.soil)
+    truth = VEHICLE.soil                  # the simulator's wet beach
+    assert abs(fit.soil.friction_angle_rad - truth.friction_angle_rad) < 3 * fit.sigma[1]
+    assert abs(fit.soil.shear_modulus_m - truth.shear_modulus_m) < 3 * fit.sigma[2]
+    assert abs(fit.soil.cohesion_pa - truth.cohesion_pa) < 3 * fit.sigma[0]
+    assert fit.residual_rms_n < 40.0
+    # all samples, the stopped tracks' clipped slips and the gripping ones included: off
+    everything = fit_terrain.fit_soil(fit_terrain.read_samples(bag), AREA,
+                                      BODY.track_contact_length_m, initial=VEHICLE.soil,
+                                      slip_range=(0.0, 1.0))
+    assert abs(everything.soil.friction_angle_rad - truth.friction_angle_rad) \
+        > 3 * everything.sigma[1]
 
 
 def test_refuses_what_is_not_a_bag(tmp_path, capsys):
