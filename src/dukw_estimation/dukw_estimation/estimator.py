@@ -625,19 +625,15 @@ class Estimator:
         return False
 
     def _tracks_pushing(self) -> bool:
-        """Both tracks turn and push (brake) the vehicle harder than paddling could: on the
-        sand. From the smoothed forces less the drivetrain friction, fresh status only."""
+        """Both tracks push or brake the vehicle harder than water could (paddling belts,
+        a held belt's drag): on the sand. From the smoothed forces less the drivetrain
+        friction, fresh status only; a held (stopped) belt braking counts as well."""
         st = self.settings
-        s = self.tracks
-        if st.contact_track_force_n <= 0.0 or s is None or self.t_s is None \
+        if st.contact_track_force_n <= 0.0 or self.tracks is None or self.t_s is None \
                 or not self._fresh('tracks', self.t_s):
             return False
-        for k, side in enumerate((s.port, s.stbd)):
-            if abs(side.speed_mps) < st.force_update_min_track_speed_mps:
-                return False
-            if not abs(self._measured_soil_force_n(k)) >= st.contact_track_force_n:
-                return False
-        return True
+        return all(abs(self._measured_soil_force_n(k)) >= st.contact_track_force_n
+                   for k in range(2))
 
     def _measured_soil_force_n(self, k: int) -> float:
         """Track k's (0 port, 1 starboard) smoothed current x gain less the drivetrain's own

@@ -53,7 +53,7 @@ class Drive:
         self.rng = np.random.default_rng(seed)
         self.t = 0.0
 
-    def run(self, seconds, track_speed=(1.1, 1.3), gps=True, extra=None):
+    def run(self, seconds, track_speed=(1.1, 1.3), gps=True, extra=None, track_force_n=100.0):
         n = self.rng.normal
         for _ in range(int(round(seconds / 0.01))):
             self.t += 0.01
@@ -70,7 +70,7 @@ class Drive:
                     self.t, self.u * math.cos(self.yaw) + n(0, 0.03),
                     self.u * math.sin(self.yaw) + n(0, 0.03)))
             if k % 5 == 0:
-                self.est.add_tracks(tracks(self.t, *track_speed))
+                self.est.add_tracks(tracks(self.t, *track_speed, track_force_n))
                 if extra:
                     extra(self)
 
@@ -201,7 +201,7 @@ def test_deep_water_is_afloat_and_a_valid_sounding_pins_the_waterline_distance()
     def sounding(d):
         floor = min(d.x * math.tan(slope), VEHICLE.site.sea_floor_depth_m)
         est.add_depth(DepthReading(d.t, True, floor - body.draft_m + mounts.depth_sounder_z_m))
-    drive.run(10.0, track_speed=(0.0, 0.0), extra=sounding)
+    drive.run(10.0, track_speed=(0.0, 0.0), extra=sounding, track_force_n=0.0)  # belts held
     out = est.traction()
     assert out.afloat
     assert out.weight_on_tracks_fraction == 0.0
@@ -369,6 +369,13 @@ def test_both_tracks_pushing_hard_mean_the_sand_even_when_the_imu_rolls():
         smoother.kf.x[0, 0] = drive.track_friction_n(k == 0) + 20.0
     assert not est._tracks_pushing()
     assert est._floating(VEHICLE.body.displaced_volume_m3 * 1.1)
+    est.tracks = tracks(1.0, 0.0, 0.0)          # held belts braking a vehicle on the sand
+    for smoother in est.force:
+        smoother.kf.x[0, 0] = -120.0
+    assert est._tracks_pushing()
+    for smoother in est.force:                  # held belts dragged through the water
+        smoother.kf.x[0, 0] = -10.0
+    assert not est._tracks_pushing()
 
 
 def _heaving_afloat(est, seconds=12.0, amplitude_m=0.1, hz=0.3):
