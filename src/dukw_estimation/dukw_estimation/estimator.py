@@ -30,6 +30,7 @@ SLOPE_FRACTION = 0.9             # above this share the pitch is the beach's, no
 TOUCHDOWN_SHARE = 0.8           # afloat until the mean-surface volume drops below this share
 FRACTION_PERIOD_S = 0.1          # how often the IMU path refreshes the weight share
 FRICTION_SPEED_MPS = 0.1         # the drivetrain friction builds up over this belt speed
+SECANT_STEPS_M = (0.005, 0.02, 0.05, 0.1, 0.2)   # surface steps of the force's derivative
 
 
 class Estimator:
@@ -439,9 +440,9 @@ class Estimator:
         """The smoothed track forces against the Wong force of the estimated weight: a
         measurement of the surface (vehicle.md 6), where both tracks turn and slip enough for
         the force to depend on the weight (a stopped or gripping track takes whatever force
-        holds it), the vehicle has lain on the sand a moment (the smoother lags a touchdown)
-        and the weight is not all on the tracks or all afloat. The ground speed's uncertainty
-        joins the force noise through the slip."""
+        holds it), ``force_update.settle_s`` after a touchdown, and the surface can change
+        the force (``_force_per_m``). The ground speed's uncertainty joins the force noise
+        through the slip."""
         st = self.settings
         if self.afloat:
             self._grounded_since_s = math.inf
@@ -494,8 +495,8 @@ class Estimator:
         soil than about water, and only the local derivative counts.
         """
         x = self.ekf.x
-        steps = (0.005,) if measured_n <= predicted_n else (0.005, 0.02, 0.05, 0.1, 0.2)
-        direction = 1.0 if measured_n <= predicted_n else -1.0
+        less_water = measured_n > predicted_n
+        steps, direction = (SECANT_STEPS_M, -1.0) if less_water else (SECANT_STEPS_M[:1], 1.0)
         for step_m in steps:
             moved = self._soil_force_n(x[Idx.S], x[Idx.ETA] + direction * step_m, track_mps,
                                        ground_mps)
