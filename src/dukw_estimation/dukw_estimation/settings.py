@@ -114,9 +114,9 @@ class EkfSettings:
     contact_min_volume_share: float = _f('contact.min_volume_share',
                                          'floating needs at least this share of the '
                                          'displacement under water (bumps on land)', 0, 1)
-    contact_track_force_n: float = _f('contact.track_force_n', 'both turning tracks pushing '
-                                      'this hard past their friction touch the sand, whatever '
-                                      'the IMU says (paddling afloat pushes less; 0: off)',
+    contact_track_force_n: float = _f('contact.track_force_n', 'both tracks pushing or '
+                                      'braking this hard past their friction touch the sand, '
+                                      'whatever the IMU says (water gives less; 0: off)',
                                       0, 1e4)
     gps_bias_sigma_m: float = _f('gps_bias.sigma_m', 'slowly drifting DGPS position error '
                                  'sigma (0: no bias states, message covariance used)', 0, 100)
