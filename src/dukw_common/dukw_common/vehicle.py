@@ -77,6 +77,7 @@ class DrivetrainParams:
     continuous_current_limit_a: float
     motor_voltage_v: float
     no_load_current_a: float
+    friction_fade_mps: float         # belt speed over which the no-load current builds up
     friction_n: float                # belt friction per track beyond the no-load current
     port_extra_friction_n: float     # the port track's extra friction (the 4 % port bias)
     sprocket_diameter_m: float

@@ -29,7 +29,6 @@ GROUNDED_FRACTION = 0.5          # above this weight share the tracks drive the 
 SLOPE_FRACTION = 0.9             # above this share the pitch is the beach's, not the waves'
 TOUCHDOWN_SHARE = 0.8           # afloat until the mean-surface volume drops below this share
 FRACTION_PERIOD_S = 0.1          # how often the IMU path refreshes the weight share
-FRICTION_SPEED_MPS = 0.1         # the drivetrain friction builds up over this belt speed
 SECANT_STEPS_M = (0.005, 0.02, 0.05, 0.1, 0.2)   # surface steps of the force's derivative
 
 
@@ -639,14 +638,15 @@ class Estimator:
     def _measured_soil_force_n(self, k: int) -> float:
         """Track k's (0 port, 1 starboard) smoothed current x gain less the drivetrain's own
         friction (no-load current, belt), which opposes the belt, not the sand: the soil's
-        force, N (NaN before a status). The friction fades in over the first 0.1 m/s of belt
-        speed, as a stopped belt's does."""
+        force, N (NaN before a status). The friction fades in over the first
+        ``drivetrain.friction_fade_mps`` of belt speed, as in the simulator."""
         force = self.force[k].force_n
         if self.tracks is None or not math.isfinite(force):
             return math.nan
         speed = (self.tracks.port, self.tracks.stbd)[k].speed_mps
-        friction = self.vehicle.drivetrain.track_friction_n(k == 0)
-        return force - friction * math.tanh(speed / FRICTION_SPEED_MPS)
+        drive = self.vehicle.drivetrain
+        fade = math.tanh(speed / drive.friction_fade_mps)
+        return force - drive.track_friction_n(k == 0) * fade
 
     def _afloat_volume(self) -> float:
         """Floating: the displacement, plus what the heave acceleration says (IMU fresh)."""

@@ -313,7 +313,7 @@ class SimCore:
         # --- track drives
         land = p.land
         drive = veh.drivetrain
-        full = veh.drivetrain.full_scale_track_speed_mps
+        full = drive.full_scale_track_speed_mps
         targets = [act.port_track_pct / 100.0 * full, act.stbd_track_pct / 100.0 * full]
         if targets[0] != 0.0:
             targets[0] -= math.copysign(min(abs(targets[0]), self._port_droop_mps), targets[0])
@@ -609,7 +609,8 @@ class SimCore:
         else:
             speeds, forces, motor, slips = [0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0]
         gain = drive.track_force_gain_n_per_a
-        currents = [motor[i] / gain + drive.no_load_current_a * math.tanh(speeds[i] / 0.1)
+        currents = [motor[i] / gain
+                    + drive.no_load_current_a * math.tanh(speeds[i] / drive.friction_fade_mps)
                     for i in range(2)]
         prop_i = [self.params.water.prop_max_current_a
                   * min(abs(thrust[i]) / drive.max_prop_thrust_n, 1.0) ** 1.5 for i in range(2)]
