@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from typing import Callable, Sequence
 
 import rclpy
-from rclpy.executors import Executor, SingleThreadedExecutor
+from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -115,7 +115,8 @@ def default_executor() -> Executor:
 
 def run_node(factory: Callable[[], Node], args: list[str] | None = None,
              executor_factory: Callable[[], Executor] = default_executor) -> int:
-    """Run one node until SIGINT/SIGTERM, then let it stop safely and exit 0.
+    """Run one node until SIGINT/SIGTERM, or until it shuts its context down itself, then
+    let it stop safely and exit 0.
 
     The node may define ``on_shutdown()``: it runs while the context is still up,
     so it can publish a last neutral command. A ConfigError at construction
@@ -134,6 +135,8 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
         executor.add_node(node)
         while not stop.is_set() and rclpy.ok():
             executor.spin_once(timeout_sec=0.05)
+    except ExternalShutdownException:
+        pass                     # the node ended itself (context.try_shutdown()): exit 0
     except ConfigError as exc:
         print(f'[FATAL] {exc}', file=sys.stderr)
         code = 2

@@ -141,4 +141,5 @@ def test_maneuver_node_plays_with_bias_and_aborts_when_the_operator_takes_over()
             while proc.alive() and time.monotonic() < deadline:
                 executor.spin_once(timeout_sec=0.05)
             assert not proc.alive(), 'maneuver_node should exit after an abort'
-        assert 'RC operator' in proc.stderr
+        assert 'RC operator' in proc.stderr, proc.stderr
+        assert proc.proc.returncode == 0 and 'Traceback' not in proc.stderr, proc.stderr
