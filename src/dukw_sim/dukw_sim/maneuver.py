@@ -152,8 +152,15 @@ def circle(medium: str, port: float, stbd: float, duration_s: float = 30.0, seed
 
 
 def zigzag(medium: str, high: float, low: float, period_s: float = 10.0,
-           duration_s: float = 30.0, seed: int = 0, config: str | None = None) -> Run:
-    """Alternate (high, low) and (low, high) every ``period_s`` (the paper's zigzag tests)."""
+           duration_s: float = 30.0, seed: int = 0, config: str | None = None,
+           lead_in_s: float = 0.0) -> Run:
+    """Alternate (high, low) and (low, high) every ``period_s`` (the paper's zigzag tests).
+
+    ``lead_in_s`` of zero commands at rest come first (as a field recording started
+    before the manoeuvre has): the start from rest is what shows the common-mode gain.
+    """
+    if lead_in_s < 0.0:
+        raise ValueError(f'lead_in_s must be >= 0, got {lead_in_s}')
     sim = SimCore.from_config(config, seed=seed)
     land = medium == 'land'
     if land:
@@ -163,11 +170,13 @@ def zigzag(medium: str, high: float, low: float, period_s: float = 10.0,
     make = _tracks if land else _props
 
     def command(t: float) -> Actuation:
-        first = int(t // period_s) % 2 == 0
+        if t < lead_in_s:
+            return make(0.0, 0.0)
+        first = int((t - lead_in_s) // period_s) % 2 == 0
         return make(high, low) if first else make(low, high)
 
     run = Run('zigzag')
-    _drive(sim, run, duration_s, command)
+    _drive(sim, run, lead_in_s + duration_s, command)
     r = run.array(lambda t: t.yaw_rate_rps)
     run.summary = {
         'maneuver': 'zigzag', 'medium': medium, 'high_pct': high, 'low_pct': low,
@@ -338,6 +347,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument('--low', type=_pct, required=True)
     p.add_argument('--period', type=_positive, default=10.0)
     p.add_argument('--duration', type=_positive, default=30.0)
+    p.add_argument('--lead-in', type=_non_negative, default=0.0,
+                   help='seconds at rest with zero commands first (sysid: use 2)')
     p = sub.add_parser('incline', parents=[common], help='climb a slope on dry sand')
     p.add_argument('--slope-deg', type=_slope, required=True)
     p.add_argument('--command', type=_pct, required=True)
@@ -364,7 +375,8 @@ def run_from_args(args: argparse.Namespace) -> Run:
     if args.maneuver == 'circle':
         return circle(args.medium, args.port, args.stbd, args.duration, **common)
     if args.maneuver == 'zigzag':
-        return zigzag(args.medium, args.high, args.low, args.period, args.duration, **common)
+        return zigzag(args.medium, args.high, args.low, args.period, args.duration,
+                      lead_in_s=args.lead_in, **common)
     if args.maneuver == 'incline':
         return incline(args.slope_deg, args.command, args.duration, stbd=args.stbd, **common)
     if args.maneuver == 'transition':
