@@ -7,6 +7,7 @@ import yaml
 
 from dukw_estimation import sysid
 from dukw_estimation.sysid_cli import load_model, main, save_model
+from dukw_estimation.sysid_io import read_run
 from dukw_sim import maneuver
 
 pytestmark = pytest.mark.timeout(120)
@@ -208,3 +209,20 @@ def test_model_file_round_trips(tmp_path):
     # what the file says the equations are, with numpy alone
     u = np.full((400, 2), 10.0) + data['u_offset']
     np.testing.assert_allclose(sysid.simulate(back, u), sysid.simulate(model, u))
+
+
+def _paper_pairs():
+    from dukw_estimation.sysid_cli import _paper_reference
+    pairs = _paper_reference(None)['zigzag_pairs']
+    return [(medium, high, low) for medium in ('land', 'water') for high, low in pairs[medium]]
+
+
+@pytest.mark.parametrize('medium,high,low', _paper_pairs())
+def test_every_paper_zigzag_is_one_command_sysid_reads(medium, high, low, tmp_path):
+    path = tmp_path / 'run.csv'
+    maneuver.main(['zigzag', '--medium', medium, '--high', str(high), '--low', str(low),
+                   '--lead-in', '2', '--csv', str(path)])
+    run = sysid.resample(read_run(path, medium))
+    sysid.check_run(run, medium)         # long enough, excited, of its medium
+    assert run.duration_s == pytest.approx(32.0, abs=0.02)
+    assert np.ptp(run.u_pct[:, 0]) == pytest.approx(high)   # from rest to the high side
