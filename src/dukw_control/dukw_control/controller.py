@@ -22,6 +22,7 @@ from dukw_control.guards import InclineGuard, InclineState, StuckDetector
 from dukw_control.limits import (CurrentLimiter, CurrentLimitSettings, PiCorrector, RateLimiter,
                                  validate_twist)
 from dukw_control.mixer import NEUTRAL, LandMixer, SidePair, WaterMixer, apply_port_bias
+from dukw_control.model_gains import PiGains, settings_with_model_gains
 from dukw_control.modes import Mode, ModeDecision
 
 
@@ -76,7 +77,16 @@ NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
     ('stuck.speed_threshold_mps', '... with ground speed below this ...', 0.0, 2.0),
     ('stuck.min_command_pct', '... at a track command of at least this ...', 0.0, 100.0),
     ('stuck.hold_s', '... for this long: stuck, s', 0.0, 600.0),
+    ('gains.source', "PI gains: 'hand' (the *_kp/*_ki above) or 'model' (IMC from the "
+     'identified models below, dukw_control.model_gains)', None, None),
+    ('gains.land_model', "land model file of 'sysid identify' (gains.source 'model')", None,
+     None),
+    ('gains.water_model', "water model file of 'sysid identify' (gains.source 'model')", None,
+     None),
+    ('gains.lambda_factor', 'IMC: closed-loop time constant / the model time constant',
+     0.05, 20.0),
 )
+GAIN_SOURCES = ('hand', 'model')
 
 
 @dataclass(frozen=True)
@@ -117,6 +127,7 @@ class ControllerSettings:
     stuck_speed_threshold_mps: float
     stuck_min_command_pct: float
     stuck_hold_s: float
+    water_gains: PiGains | None = None    # afloat PI gains; None: the same as on land
 
     def __post_init__(self) -> None:
         if not 0 < self.timeout_ramp_s <= self.cmd_timeout_s:
@@ -143,13 +154,22 @@ def settings_from_params(p: Mapping[str, ParamValue]) -> ControllerSettings:
     fields = ControllerSettings.__dataclass_fields__
     scalars = {name.replace('.', '_'): f(name) for name, *_ in NODE_PARAMS
                if name.replace('.', '_') in fields and name != 'closed_loop'}
-    return ControllerSettings(
+    settings = ControllerSettings(
         land=land, water=water, current=current,
         closed_loop=require(p, 'closed_loop', bool),
         port_bias_land_pct=drive.port_bias_pct * f('land.port_bias_scale'),
         port_bias_water_pct=drive.port_bias_pct * f('water.port_bias_scale'),
         incline_sustained_rad=lim.incline_sustained_rad,
         incline_brief_rad=lim.incline_brief_rad, **scalars)
+    source = require(p, 'gains.source', str)
+    if source not in GAIN_SOURCES:
+        raise ValueError(f'gains.source must be one of {GAIN_SOURCES}, got {source!r}')
+    if source == 'hand':
+        return settings
+    paths = [require(p, f'gains.{m}_model', str) for m in ('land', 'water')]
+    if not any(paths):
+        raise ValueError("gains.source 'model' needs gains.land_model or gains.water_model")
+    return settings_with_model_gains(settings, [x for x in paths if x], f('gains.lambda_factor'))
 
 
 @dataclass(frozen=True)
@@ -336,6 +356,7 @@ class DriveController:
             self.speed_pi.reset()
             self.yaw_pi.reset()
         elif closed:
+            self._use_gains(s.water_gains if prop_w > track_w else None)
             main = self._last_mix_flags
             derated = min(c.scale for c in self.current.values()) < 1.0 and track_w > 0
             speed_cmd += self.speed_pi.update(speed_sp - i.odom[0], dt,
@@ -357,6 +378,13 @@ class DriveController:
                               tracks.stbd * self.current['stbd'].scale)
         self.output = ControlOutput(tracks.scaled(fade), props.scaled(fade))
         return self.output
+
+    def _use_gains(self, gains: PiGains | None) -> None:
+        """PI gains of the medium that carries the vehicle (None: the land / hand ones)."""
+        s = self.s
+        g = gains or PiGains(s.speed_kp, s.speed_ki, s.yaw_kp, s.yaw_ki)
+        self.speed_pi.kp, self.speed_pi.ki = g.speed_kp, g.speed_ki
+        self.yaw_pi.kp, self.yaw_pi.ki = g.yaw_kp, g.yaw_ki
 
     def _descending(self, speed_mps: float) -> bool:
         """Driving down a slope steep enough to matter: the way off it is never derated.
