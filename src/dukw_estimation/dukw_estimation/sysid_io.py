@@ -3,7 +3,8 @@
 ROS-free: bags are read with ``rosbags`` and the dukw_msgs ``.msg`` text. Inputs are
 ``tracks/cmd`` (land) or ``props/cmd`` (water); outputs u, v, r from the twist of
 ``odometry/filtered`` (body axes, base_link) or, with ``truth``, from ``sim/truth``.
-The medium of a bag comes from ``sim/truth`` or else ``drive_mode`` (most samples).
+The medium of a bag comes from ``sim/truth`` or else ``drive_mode``: a bag that also
+holds other media (a whole mission) gives its longest stretch in the asked medium.
 """
 from __future__ import annotations
 
@@ -24,6 +25,7 @@ CSV_COMMANDS = {'land': ('port_cmd', 'stbd_cmd'), 'water': ('port_prop_cmd', 'st
 CSV_OUTPUTS = ('u', 'v', 'r')
 #: SimTruth.medium / DriveMode.mode values (dukw_msgs) -> medium name.
 MEDIUM_CODES = {0: 'land', 1: 'transition', 2: 'water', 3: 'safe stop'}
+MEDIUM_NAMES = {name: code for code, name in MEDIUM_CODES.items()}
 
 
 def majority_medium(codes: np.ndarray) -> str:
@@ -100,15 +102,32 @@ def read_bag(path: str | Path, medium: str, truth: bool = False) -> Run:
                        m.twist.twist.angular.z) for _, m in data[out_topic]])
     t_u = np.array([t for t, _ in data[cmd_topic]])
     u = np.array([(m.port_pct, m.stbd_pct) for _, m in data[cmd_topic]])
-    if data[TRUTH_TOPIC]:
-        found = majority_medium(np.array([m.medium for _, m in data[TRUTH_TOPIC]]))
-    elif data[MODE_TOPIC]:
-        found = majority_medium(np.array([m.mode for _, m in data[MODE_TOPIC]]))
-    else:
-        found = medium      # nothing recorded says otherwise: trust the user
+    source = data[TRUTH_TOPIC] or data[MODE_TOPIC]   # empty: nothing says; trust the user
+    t_m = [t for t, _ in source]
+    codes = [m.medium if hasattr(m, 'medium') else m.mode for _, m in source]
     keep = t_y >= t_u[0]
-    return Run(path.name, found, t_y[keep], _held(t_u, u, t_y[keep]), y[keep]) \
-        if keep.sum() >= 2 else Run(path.name, found, t_y, _held(t_u, u, t_y), y)
+    t_y, y = t_y[keep], y[keep]
+    if codes:
+        media = _held(np.array(t_m), np.array(codes), t_y) if t_y.size else np.array(codes)
+        found = majority_medium(np.array(codes))
+        lo, hi = _longest_stretch(media, MEDIUM_NAMES[medium])
+        if hi - lo >= 2:          # the bag's longest stretch in the asked medium
+            found, t_y, y = medium, t_y[lo:hi], y[lo:hi]
+    else:
+        found = medium
+    return Run(path.name, found, t_y, _held(t_u, u, t_y), y)
+
+
+def _longest_stretch(codes: np.ndarray, wanted: int) -> tuple[int, int]:
+    """[start, end) of the longest run of ``wanted`` in ``codes`` ((0, 0) if none)."""
+    best, start = (0, 0), None
+    for k, code in enumerate(list(codes) + [None]):
+        if code == wanted and start is None:
+            start = k
+        elif code != wanted and start is not None:
+            best = max(best, (start, k), key=lambda s: s[1] - s[0])
+            start = None
+    return best
 
 
 def _held(t_u: np.ndarray, u: np.ndarray, t: np.ndarray) -> np.ndarray:

@@ -127,8 +127,9 @@ def _write_bag(path, run: maneuver.Run, medium_code: int, rate_hz: float = 50.0,
                                                                 child_frame_id='base_link',
                                                                 pose=pose, twist=twist))
             if 'drive_mode' in topics:
+                code = medium_code(row.t_s) if callable(medium_code) else medium_code
                 writer.write_message('/drive_mode', 'dukw_msgs/msg/DriveMode', ns + 2, t[
-                    'dukw_msgs/msg/DriveMode'](header=header, mode=medium_code, automatic=True,
+                    'dukw_msgs/msg/DriveMode'](header=header, mode=code, automatic=True,
                                                track_weight=1.0, prop_weight=0.0,
                                                tracks_idle=False, reason=''))
     return path
@@ -151,6 +152,15 @@ def test_identify_from_a_recorded_bag(land_zigzag_run, tmp_path, capsys):
     # the operating point recorded: mean commands over 2 s at rest and three half-periods
     expected = [(56 * 20 + 32 * 10) / 32, (32 * 20 + 56 * 10) / 32]
     assert model.u_offset == pytest.approx(expected, abs=0.5)
+
+
+def test_a_bag_of_several_media_gives_its_stretch_in_the_asked_one(land_zigzag_run, tmp_path,
+                                                                   capsys):
+    bag = _write_bag(tmp_path / 'mixed', land_zigzag_run, lambda t: 0 if t < 20.0 else 2,
+                     topics=('tracks/cmd', 'odometry/filtered', 'drive_mode'))
+    assert main(['identify', '--medium', 'land', str(bag)]) == 0
+    out = capsys.readouterr().out
+    assert 'mixed: 19.9 s' in out or 'mixed: 20.0 s' in out, out
 
 
 def test_refusals(land_zigzag_run, zigzags, tmp_path, capsys):
