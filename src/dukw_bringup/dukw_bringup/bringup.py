@@ -10,7 +10,9 @@ file (config/stack_sim.yaml, config/stack_boat.yaml) lists the nodes:
         - {name: sim_node, package: dukw_sim, executable: sim_node, args: [-p, rate_hz:=100.0]}
 
 ``args`` are ROS arguments (after the parameter files), ``cli_args`` the program's
-own (before ``--ros-args``), ``rename: true`` runs the node under ``name``.
+own (before ``--ros-args``), ``rename: true`` runs the node under ``name``. A stack
+with ``clock_node: sim_node`` runs every other node with ``use_sim_time:=true``
+(as the launch file and the main job do), so stamps and ages share one clock.
 
 Each node runs as ``<prefix>/lib/<package>/<executable> --ros-args
 [-r __node:=<name>] --params-file <file>... <args>`` in its own session (so a
@@ -60,6 +62,11 @@ class StackSpec:
 
     name: str
     nodes: tuple[NodeSpec, ...]
+    clock_node: str | None = None   # publishes /clock: every other node uses sim time
+
+    def uses_sim_time(self, spec: NodeSpec) -> bool:
+        """Whether ``spec`` runs on the clock node's /clock."""
+        return self.clock_node is not None and spec.name != self.clock_node
 
     def node(self, name: str) -> NodeSpec:
         """The node called ``name``; KeyError if there is none."""
@@ -97,7 +104,10 @@ def parse_stack(doc: Any, source: str = 'stack') -> StackSpec:
     names = [n.name for n in nodes]
     if len(set(names)) != len(names):
         raise ConfigError(f'{source}: node names must be unique, got {names}')
-    return StackSpec(str(tree.get('name', Path(source).stem)), tuple(nodes))
+    clock_node = tree.get('clock_node')
+    if clock_node is not None and clock_node not in names:
+        raise ConfigError(f'{source}: stack.clock_node {clock_node!r} is not one of {names}')
+    return StackSpec(str(tree.get('name', Path(source).stem)), tuple(nodes), clock_node)
 
 
 def load_stack(path: str | Path) -> StackSpec:
@@ -126,7 +136,8 @@ def node_executable(package: str, executable: str) -> Path:
     return path
 
 
-def node_command(spec: NodeSpec, params_files: Sequence[Path]) -> list[str]:
+def node_command(spec: NodeSpec, params_files: Sequence[Path],
+                 sim_time: bool = False) -> list[str]:
     """The command line that runs one node."""
     command = [str(node_executable(spec.package, spec.executable)), *spec.cli_args,
                '--ros-args']
@@ -134,6 +145,8 @@ def node_command(spec: NodeSpec, params_files: Sequence[Path]) -> list[str]:
         command += ['-r', f'__node:={spec.name}']
     for params in params_files:
         command += ['--params-file', str(params)]
+    if sim_time:
+        command += ['-p', 'use_sim_time:=true']
     return command + list(spec.args)
 
 
@@ -186,7 +199,8 @@ class Runner:
     # -- life cycle
     def start(self) -> None:
         """Start every node in order; on a failure stop those already started and re-raise."""
-        commands = [node_command(spec, self.params_files) for spec in self.stack.nodes]
+        commands = [node_command(spec, self.params_files, self.stack.uses_sim_time(spec))
+                    for spec in self.stack.nodes]
         if self.log_dir is not None:
             self.log_dir.mkdir(parents=True, exist_ok=True)
         try:

@@ -29,7 +29,7 @@ def _nodes(context):
     nodes = []
     for entry in stack['nodes']:
         parameters = [params_file]
-        if sim and entry['executable'] != 'sim_node':
+        if stack.get('clock_node') not in (None, entry['name']):
             parameters.append({'use_sim_time': True})
         nodes.append(Node(
             package=entry['package'], executable=entry['executable'], name=entry['name'],
