@@ -195,3 +195,13 @@ def s_to_stamp(t_s: float):
     from builtin_interfaces.msg import Time
     sec = int(t_s // 1)
     return Time(sec=sec, nanosec=int(round((t_s - sec) * 1e9)) % 1_000_000_000)
+
+
+def publisher_sources(node, topic: str) -> tuple[int, tuple[str, ...]]:
+    """How many publishers ``topic`` has in the ROS graph, and (only when more than one,
+    as that costs more) the fully qualified names of their nodes."""
+    count = node.count_publishers(topic)
+    if count <= 1:
+        return count, ()
+    infos = node.get_publishers_info_by_topic(node.resolve_topic_name(topic))
+    return count, tuple(f'{i.node_namespace.rstrip("/")}/{i.node_name}' for i in infos)

@@ -16,6 +16,7 @@ from typing import Mapping
 
 from dukw_common.config import ParamValue, require
 from dukw_common.diagnostics import Health, Level
+from dukw_common.sources import SourceWatch
 from dukw_common.vehicle import drivetrain_params, limit_params, vehicle_params
 
 from dukw_control.guards import InclineGuard, InclineState, StuckDetector
@@ -199,6 +200,7 @@ class DriveController:
         self.stuck = StuckDetector(settings.stuck_slip_threshold,
                                    settings.stuck_speed_threshold_mps,
                                    settings.stuck_min_command_pct, settings.stuck_hold_s)
+        self.sources = SourceWatch()      # drive_mode and authority: one publisher each
         self._last_step_s: float | None = None
         self._last_mix_flags = (False, False)   # (speed, yaw) saturated last cycle
         self.output = ControlOutput(neutral_reason='starting')
@@ -298,6 +300,8 @@ class DriveController:
         self._last_step_s = now_s
         if not i.authority_ok:
             return self._neutral(f'no authority: {i.authority_detail}')
+        if self.sources.fault():
+            return self._stopped(f'second source: {self.sources.fault()}', now_s)
         if i.mode is None or i.mode.mode == Mode.SAFE_STOP:
             self.track_weight.reset()
             self.prop_weight.reset()
@@ -400,7 +404,7 @@ class DriveController:
             ctrl.worsen(Level.WARN, f'rejected {i.rejected} cmd_vel ({i.last_rejection})')
         if self.s.closed_loop and self._age('odometry', now_s) > self.s.odometry_timeout_s:
             ctrl.worsen(Level.WARN, 'odometry/filtered stale: open loop')
-        if 'stale' in self.output.neutral_reason:
+        if 'stale' in self.output.neutral_reason or self.sources.fault():
             ctrl.worsen(Level.ERROR, self.output.neutral_reason)
         current = Health('current limiter')
         for side, lim in self.current.items():

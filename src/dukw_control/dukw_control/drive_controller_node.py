@@ -12,8 +12,8 @@ from sensor_msgs.msg import Imu
 
 from dukw_common.config import ConfigError
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
-                                    declare_parameters, diagnostic_array, run_node,
-                                    vehicle_specs)
+                                    declare_parameters, diagnostic_array, publisher_sources,
+                                    run_node, vehicle_specs)
 from dukw_control.controller import NODE_PARAMS, DriveController, settings_from_params
 from dukw_control.convert import (ActuatorPublishers, authority_usable, decision_from_msg,
                                   pitch_from_quaternion, stamp_or)
@@ -60,12 +60,14 @@ class DriveControllerNode(Node):
                                    throttle_duration_sec=1.0)
 
     def on_authority(self, msg: Authority) -> None:
+        self.core.sources.update('authority', *publisher_sources(self, 'authority'))
         usable, detail = authority_usable(msg)
         self.core.on_authority(usable, detail, self.now_s())
         if not usable:
             self.on_timer()          # neutral at once, not at the next tick
 
     def on_mode(self, msg: DriveMode) -> None:
+        self.core.sources.update('drive_mode', *publisher_sources(self, 'drive_mode'))
         self.core.on_mode(decision_from_msg(msg))
 
     def on_odometry(self, msg: Odometry) -> None:

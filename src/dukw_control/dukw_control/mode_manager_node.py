@@ -12,6 +12,7 @@ from sensor_msgs.msg import Imu
 
 from dukw_common.config import ConfigError
 from dukw_common.diagnostics import Health, Level
+from dukw_common.sources import SourceWatch
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
                                     declare_parameters, diagnostic_array, run_node)
 from dukw_control.convert import decision_to_msg, stamp_or
@@ -30,6 +31,7 @@ class ModeManagerNode(Node):
         except ValueError as exc:
             raise ConfigError(f'mode_manager_node: {exc}') from exc
         self.republish_period_s = params['republish_period_s']
+        self.sources = SourceWatch()          # set_mode: one client, the operator's
         self.last_publish_s = -1e9
         self.mode_pub = self.create_publisher(DriveMode, 'drive_mode', STATE_QOS)
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
@@ -64,6 +66,13 @@ class ModeManagerNode(Node):
         self.core.on_attitude(stamp_or(msg, now), now)
 
     def on_set_mode(self, request: SetMode.Request, response: SetMode.Response):
+        if self.sources.update('set_mode', self.count_clients('set_mode')) or \
+                self.sources.fault():
+            self.publish_diagnostics()
+        if self.sources.fault():            # no one can tell which client is the operator
+            response.success, response.message = False, f'refused: {self.sources.fault()}'
+            self.get_logger().error(f'set_mode {response.message}')
+            return response
         if request.automatic:
             self.core.release(self.now_s())
         else:
@@ -103,6 +112,8 @@ class ModeManagerNode(Node):
             **{f'{k}_age_s': f'{v:.2f}' for k, v in self.core.input_ages(now).items()}})
         if decision.mode == Mode.SAFE_STOP:
             health.level = Level.ERROR
+        if self.sources.fault():
+            health.worsen(Level.ERROR, self.sources.fault())
         elif not decision.automatic:
             health.level = Level.WARN
             stale = self.core.stale_inputs(now)

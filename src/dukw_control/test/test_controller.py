@@ -4,6 +4,7 @@ import math
 
 import pytest
 
+from dukw_common.diagnostics import Level
 from dukw_control.controller import DriveController
 from dukw_control.modes import Mode, ModeDecision
 
@@ -155,6 +156,18 @@ def test_a_silent_imu_stops_the_tracks_although_pitch_keeps_coming(controller_se
     r.imu_alive = True
     out = r.run(0.1, send_cmd=False)
     assert out.tracks.is_neutral()                        # back, but waiting for a request
+    assert not r.run(0.5).tracks.is_neutral()
+
+
+def test_a_second_drive_mode_publisher_stops_and_reports_error(controller_settings):
+    r = Rig(controller_settings)
+    assert not r.run(1.0).tracks.is_neutral()
+    r.c.sources.update('drive_mode', 2, ('/mode_manager_node', '/stranger'))
+    out = r.run(DT)
+    assert out.tracks.is_neutral() and '/stranger' in out.neutral_reason
+    assert r.c.healths(r.t)[0].level == Level.ERROR
+    r.c.sources.update('drive_mode', 1)
+    assert r.run(0.1, send_cmd=False).tracks.is_neutral()
     assert not r.run(0.5).tracks.is_neutral()
 
 
