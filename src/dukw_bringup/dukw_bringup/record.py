@@ -22,7 +22,8 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from rclpy.utilities import remove_ros_args
 
 from dukw_bringup.bag_io import BagError, BagWriter, make_qos, topic_key, typestore
-from dukw_common.node_tools import run_node
+from dukw_common.config import ConfigError
+from dukw_common.node_tools import check_params_files, run_node
 
 #: Never recorded unless named explicitly: ROS's own chatter.
 IGNORED_BY_DEFAULT = ('/rosout', '/parameter_events')
@@ -165,6 +166,11 @@ def parse_args(argv: Sequence[str]) -> argparse.Namespace:
 def main(argv: Sequence[str] | None = None) -> int:
     """Console-script entry point."""
     argv = list(sys.argv if argv is None else argv)
+    try:
+        check_params_files(argv)
+    except ConfigError as exc:
+        print(f'[FATAL] record: {exc}', file=sys.stderr)
+        return 2
     args = parse_args(remove_ros_args(argv)[1:])
     if args.out.exists():
         print(f'[FATAL] record: {args.out} exists already; give a new folder', file=sys.stderr)

@@ -14,6 +14,7 @@ from typing import Callable, Sequence
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy,
@@ -21,7 +22,7 @@ from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityP
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.signals import SignalHandlerOptions
 
-from dukw_common.config import ConfigError, ParamValue, node_params
+from dukw_common.config import ConfigError, ParamValue, load_file, node_params
 from dukw_common.diagnostics import Health
 
 #: Sensor streams: best effort, keep last 5 (rclpy's sensor-data profile).
@@ -40,14 +41,16 @@ class ParamSpec:
     """A parameter a node declares: its name, meaning and allowed range.
 
     The default value comes from the stack's parameter file (config/dukw.yaml),
-    never from code; ``--params-file`` and ``-p`` override it as usual.
+    never from code; ``--params-file`` and ``-p`` override it as usual. Nodes build
+    their cores once from these values, so every parameter is read-only at run time:
+    a ``set_parameters`` call is refused ("read-only"), never accepted and ignored.
     """
 
     name: str
     description: str
     min: float | None = None
     max: float | None = None
-    read_only: bool = False
+    read_only: bool = True
 
 
 def declare_parameters(node: Node, specs: Sequence[ParamSpec],
@@ -123,7 +126,12 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
     prints a clear message and exits 2. ``executor_factory`` may give another
     executor; every executor is spun with a timeout.
     """
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    try:
+        check_params_files(sys.argv if args is None else args)
+        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    except (ConfigError, _rclpy.RCLError) as exc:   # e.g. malformed ROS arguments
+        print(f'[FATAL] {exc}', file=sys.stderr)
+        return 2
     stop = threading.Event()
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: stop.set())
@@ -148,6 +156,17 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
             node.destroy_node()
         rclpy.try_shutdown()
     return code
+
+
+def check_params_files(argv: Sequence[str]) -> None:
+    """Raise ConfigError naming the file if a ``--params-file`` is missing or malformed
+    (rcl would only say RCLError, with a traceback)."""
+    argv = list(argv)
+    for i, arg in enumerate(argv):
+        if arg == '--params-file':
+            if i + 1 >= len(argv):
+                raise ConfigError('--params-file needs a file name')
+            load_file(argv[i + 1])
 
 
 def vehicle_specs(*groups: str) -> list[ParamSpec]:
