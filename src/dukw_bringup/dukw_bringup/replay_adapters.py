@@ -84,7 +84,7 @@ class ModeManagerAdapter(CoreAdapter):
             self.core.on_traction(msg.weight_on_tracks_fraction, t_s)
         elif topic == 'tracks/status' and msg.connected:
             self.core.on_track_forces(msg.port.force_n, msg.stbd.force_n, t_s)
-        elif topic == 'imu/data' and hasattr(self.core, 'on_attitude'):
+        elif topic == 'imu/data':
             self.core.on_attitude(_stamp_or(msg, t_s), t_s)
         return None
 
@@ -131,7 +131,7 @@ class DriveControllerAdapter(CoreAdapter):
             if not usable:
                 return self._step(t_s)  # the node goes neutral at once
         elif topic == 'drive_mode':
-            core.on_mode(self.convert.decision_from_msg(msg))
+            core.on_mode(self.convert.decision_from_msg(msg), t_s)
         elif topic == 'odometry/filtered':
             core.on_odometry(msg.twist.twist.linear.x, msg.twist.twist.angular.z, t_s)
             if self.pitch_from_odometry:
@@ -141,8 +141,7 @@ class DriveControllerAdapter(CoreAdapter):
                 self.last_event_step_s = t_s
                 return self._step(t_s)
         elif topic == 'imu/data':
-            if hasattr(core, 'on_attitude'):
-                core.on_attitude(_stamp_or(msg, t_s), t_s)
+            core.on_attitude(_stamp_or(msg, t_s), t_s)
             if not self.pitch_from_odometry:
                 core.on_pitch(self.convert.pitch_from_imu(msg), t_s)
         elif topic == 'traction':

@@ -228,8 +228,15 @@ class DriveController:
             self._reset()
         self.i.authority_ok, self.i.authority_detail = usable, detail
 
-    def on_mode(self, decision: ModeDecision) -> None:
-        """The mode manager's latest decision."""
+    def on_mode(self, decision: ModeDecision, now_s: float | None = None) -> None:
+        """The mode manager's latest decision, arrived at ``now_s``.
+
+        A safe stop, and the end of one, count as stops even between two control steps:
+        only a cmd_vel that arrives after them drives again.
+        """
+        modes = (decision.mode, self.i.mode.mode if self.i.mode else None)
+        if now_s is not None and Mode.SAFE_STOP in modes:
+            self.i.stopped_s = max(self.i.stopped_s, now_s)
         self.i.mode = decision
 
     def on_odometry(self, surge_mps: float, yaw_rate_rps: float, now_s: float) -> None:

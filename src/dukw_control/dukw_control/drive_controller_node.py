@@ -68,7 +68,7 @@ class DriveControllerNode(Node):
 
     def on_mode(self, msg: DriveMode) -> None:
         self.core.sources.update('drive_mode', *publisher_sources(self, 'drive_mode'))
-        self.core.on_mode(decision_from_msg(msg))
+        self.core.on_mode(decision_from_msg(msg), self.now_s())
 
     def on_odometry(self, msg: Odometry) -> None:
         now = self.now_s()

@@ -145,6 +145,16 @@ def test_safe_stop_needs_a_cmd_vel_sent_after_it(controller_settings):
     assert not r.run(0.5).tracks.is_neutral()
 
 
+def test_a_safe_stop_between_two_steps_still_needs_a_fresh_cmd_vel(controller_settings):
+    r = Rig(controller_settings)
+    r.run(2.0)
+    r.c.on_mode(ModeDecision(Mode.SAFE_STOP, True, 0.0, 0.0, False, 'forced'), r.t + 0.002)
+    r.c.on_mode(LAND, r.t + 0.004)                        # never seen by a step
+    r.t += DT
+    out = r.c.step(r.t)
+    assert out.tracks.is_neutral() and 'since the stop' in out.neutral_reason
+
+
 def test_a_silent_imu_stops_the_tracks_although_pitch_keeps_coming(controller_settings):
     r = Rig(controller_settings)
     assert not r.run(2.0).tracks.is_neutral()
