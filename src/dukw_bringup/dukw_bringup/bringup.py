@@ -13,6 +13,9 @@ file (config/stack_sim.yaml, config/stack_boat.yaml) lists the nodes:
 own (before ``--ros-args``), ``rename: true`` runs the node under ``name``. A stack
 with ``clock_node: sim_node`` runs every other node with ``use_sim_time:=true``
 (as the launch file and the main job do), so stamps and ages share one clock.
+``discovery_range: LOCALHOST`` (both stacks) keeps the ROS graph on the vehicle:
+the nodes get ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` unless the environment
+sets it explicitly (README "Security").
 
 Each node runs as ``<prefix>/lib/<package>/<executable> --ros-args
 [-r __node:=<name>] --params-file <file>... <args>`` in its own session (so a
@@ -42,6 +45,8 @@ from dukw_common.config import ConfigError, default_config_path
 
 _NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')
 _PR_SET_PDEATHSIG = 1
+DISCOVERY_ENV = 'ROS_AUTOMATIC_DISCOVERY_RANGE'
+DISCOVERY_RANGES = ('LOCALHOST', 'SUBNET', 'OFF', 'SYSTEM_DEFAULT')
 
 
 @dataclass(frozen=True)
@@ -63,6 +68,7 @@ class StackSpec:
     name: str
     nodes: tuple[NodeSpec, ...]
     clock_node: str | None = None   # publishes /clock: every other node uses sim time
+    discovery_range: str | None = None   # ROS_AUTOMATIC_DISCOVERY_RANGE unless already set
 
     def uses_sim_time(self, spec: NodeSpec) -> bool:
         """Whether ``spec`` runs on the clock node's /clock."""
@@ -107,7 +113,12 @@ def parse_stack(doc: Any, source: str = 'stack') -> StackSpec:
     clock_node = tree.get('clock_node')
     if clock_node is not None and clock_node not in names:
         raise ConfigError(f'{source}: stack.clock_node {clock_node!r} is not one of {names}')
-    return StackSpec(str(tree.get('name', Path(source).stem)), tuple(nodes), clock_node)
+    discovery = tree.get('discovery_range')
+    if discovery is not None and discovery not in DISCOVERY_RANGES:
+        raise ConfigError(f'{source}: stack.discovery_range must be one of {DISCOVERY_RANGES}, '
+                          f'got {discovery!r}')
+    return StackSpec(str(tree.get('name', Path(source).stem)), tuple(nodes), clock_node,
+                     discovery)
 
 
 def load_stack(path: str | Path) -> StackSpec:
@@ -192,6 +203,8 @@ class Runner:
         self.out = out or sys.stdout
         self.stop_timeout_s = stop_timeout_s
         self.env = {**os.environ, 'PYTHONUNBUFFERED': '1', **(env or {})}
+        if stack.discovery_range and not self.env.get(DISCOVERY_ENV):
+            self.env[DISCOVERY_ENV] = stack.discovery_range
         self.procs: list[NodeProc] = []
         self._lock = threading.Lock()
         self._stopping = False

@@ -35,6 +35,8 @@ def _nodes(context):
             package=entry['package'], executable=entry['executable'], name=entry['name'],
             parameters=parameters, ros_arguments=[str(a) for a in entry.get('args', [])],
             output='screen', emulate_tty=True,
+            additional_env=({'ROS_AUTOMATIC_DISCOVERY_RANGE': stack['discovery_range']}
+                            if stack.get('discovery_range') else None),
             on_exit=Shutdown(reason=f"{entry['name']} exited")))
     return nodes
 
