@@ -15,7 +15,8 @@ with ``clock_node: sim_node`` runs every other node with ``use_sim_time:=true``
 (as the launch file and the main job do), so stamps and ages share one clock.
 ``discovery_range: LOCALHOST`` (both stacks) keeps the ROS graph on the vehicle:
 the nodes get ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` unless the environment
-sets it explicitly (README "Security").
+sets it explicitly (README "Security"). With ``ROS_SECURITY_ENABLE=true`` each
+node runs in its SROS2 enclave ``/dukw/<name>`` (config/sros2/dukw_policy.xml).
 
 Each node runs as ``<prefix>/lib/<package>/<executable> --ros-args
 [-r __node:=<name>] --params-file <file>... <args>`` in its own session (so a
@@ -46,6 +47,8 @@ from dukw_common.config import ConfigError, default_config_path
 _NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')
 _PR_SET_PDEATHSIG = 1
 DISCOVERY_ENV = 'ROS_AUTOMATIC_DISCOVERY_RANGE'
+#: SROS2 enclaves of config/sros2/dukw_policy.xml: one per node, /dukw/<node name>
+ENCLAVE_ROOT = '/dukw'
 DISCOVERY_RANGES = ('LOCALHOST', 'SUBNET', 'OFF', 'SYSTEM_DEFAULT')
 
 
@@ -148,12 +151,14 @@ def node_executable(package: str, executable: str) -> Path:
 
 
 def node_command(spec: NodeSpec, params_files: Sequence[Path],
-                 sim_time: bool = False) -> list[str]:
-    """The command line that runs one node."""
+                 sim_time: bool = False, secure: bool = False) -> list[str]:
+    """The command line that runs one node (``secure``: in its SROS2 enclave)."""
     command = [str(node_executable(spec.package, spec.executable)), *spec.cli_args,
                '--ros-args']
     if spec.rename:
         command += ['-r', f'__node:={spec.name}']
+    if secure:
+        command += ['--enclave', f'{ENCLAVE_ROOT}/{spec.name}']
     for params in params_files:
         command += ['--params-file', str(params)]
     if sim_time:
@@ -212,8 +217,9 @@ class Runner:
     # -- life cycle
     def start(self) -> None:
         """Start every node in order; on a failure stop those already started and re-raise."""
-        commands = [node_command(spec, self.params_files, self.stack.uses_sim_time(spec))
-                    for spec in self.stack.nodes]
+        secure = self.env.get('ROS_SECURITY_ENABLE', '').lower() == 'true'
+        commands = [node_command(spec, self.params_files, self.stack.uses_sim_time(spec),
+                                 secure) for spec in self.stack.nodes]
         if self.log_dir is not None:
             self.log_dir.mkdir(parents=True, exist_ok=True)
         try:

@@ -138,7 +138,10 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
     node = None
     code = 0
     try:
-        node = factory()
+        try:
+            node = factory()
+        except _rclpy.RCLError as exc:   # e.g. DDS-Security asked of a DDS without it
+            raise ConfigError(f'cannot create the node: {exc}') from exc
         executor = executor_factory()
         executor.add_node(node)
         while not stop.is_set() and rclpy.ok():
