@@ -1,12 +1,14 @@
 """Fault matrix, recording (README "Failsafes").
 
 Row: the recorder dies (kill -9) mid-run. Injected: SIGKILL to the `record` process
-after 2.5 s of 50 Hz messages. Must: metadata.yaml there from the start; the bag
-opens (recovered from the MCAP) with every message older than 1 s before the kill.
+after 2.5 s of 50 Hz messages. Must: metadata.yaml there from the start; `replay`
+and the bag readers open it (rebuilt from the MCAP) with every message older than 1 s
+before the kill.
 Row: `record` and offered QoS. Injected: a publisher offering deadline, lifespan and
 manual liveliness. Must: the bag's metadata carries them as offered.
 """
 import signal
+import subprocess
 import time
 
 import pytest
@@ -15,7 +17,7 @@ from rclpy.qos import LivelinessPolicy, QoSProfile, ReliabilityPolicy
 
 from dukw_bringup import bag_io
 from dukw_common.node_tools import COMMAND_QOS
-from dukw_common.testing import NodeProcess, ros_node, spin_until
+from dukw_common.testing import NodeProcess, executable, ros_node, spin_until
 
 pytestmark = pytest.mark.ros
 
@@ -53,6 +55,9 @@ def test_recorder_killed_mid_run_leaves_a_bag_that_opens(tmp_path):
         finally:
             recorder.stop()
     assert recorder.proc.returncode == -signal.SIGKILL
+    replay = subprocess.run([str(executable('dukw_bringup', 'replay')), str(out), '--stream'],
+                            capture_output=True, text=True, timeout=60)
+    assert replay.returncode == 0 and 'recovered' in replay.stderr, replay.stderr
     seqs = [bag_io.deserialize(m).header.stamp.sec for m in bag_io.read_messages(out)]
     must_have = sum(1 for t in sent if t < killed_at - FLUSH_S - 0.2)   # 0.2 s delivery
     assert seqs == list(range(len(seqs))) and len(seqs) >= must_have, (len(seqs), must_have)
