@@ -427,6 +427,10 @@ class DriveController:
             'steep_for_s': f'{self.incline.steep_for_s:.1f}'})
         if self.incline.state != InclineState.OK:
             incline.level = Level.WARN
+        stale = [n for n in ('imu', 'pitch') if self._age(n, now_s) > self.s.imu_timeout_s]
+        if stale:                      # never "ok" on an attitude nobody measured lately
+            incline.worsen(Level.ERROR, f'{" and ".join(stale)} stale: incline unguarded, '
+                                        'tracks neutral')
         stuck = Health('stuck detection', values={'slips': _pair(SidePair(*i.slips))})
         if self.stuck.stuck:
             stuck.worsen(Level.ERROR, self.stuck.reason)

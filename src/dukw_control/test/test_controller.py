@@ -161,6 +161,8 @@ def test_a_silent_imu_stops_the_tracks_although_pitch_keeps_coming(controller_se
     r.imu_alive = False                                   # the estimator keeps predicting
     out = r.run(controller_settings.imu_timeout_s + 2 * DT)
     assert out.tracks.is_neutral() and out.neutral_reason.startswith('imu stale')
+    incline = next(h for h in r.c.healths(r.t) if h.name == 'incline guard')
+    assert incline.level == Level.ERROR and 'imu stale' in incline.message
     r.c.on_attitude(r.t - 5.0, r.t)                       # a sample measured long ago
     assert r.c.step(r.t).tracks.is_neutral()
     r.imu_alive = True
