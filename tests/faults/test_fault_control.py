@@ -216,3 +216,19 @@ def test_forcing_water_on_dry_sand_is_refused(rig):
     result = rig.call_set_mode(DriveMode.WATER)
     assert not result.success and 'WATER refused' in result.message
     assert rig.modes[-1].mode == DriveMode.LAND and rig.modes[-1].automatic
+
+
+def test_a_second_set_mode_client_is_refused_and_is_an_error(rig):
+    rig.drive()
+    stranger = rig.node.create_client(SetMode, 'set_mode')
+    rig.diag.clear()
+    try:
+        rig.spin(lambda: False, 1.0)                   # the node discovers the stranger
+        result = rig.call_set_mode(DriveMode.SAFE_STOP)   # even the safest request
+        assert not result.success and 'set_mode has 2 sources' in result.message
+        assert rig.spin(lambda: rig.error_from('mode_manager_node'), 3.0)
+        assert rig.modes[-1].mode == DriveMode.LAND
+    finally:
+        rig.node.destroy_client(stranger)
+    rig.spin(lambda: False, 1.0)                       # ... and that it is gone
+    assert rig.call_set_mode(None).success
