@@ -36,6 +36,8 @@ _NEVER = QosTime(sec=0, nsec=0)
 #: so a recorder killed mid-run loses at most this much (issue 17).
 FLUSH_PERIOD_S = 1.0
 _MCAP_MAGIC = b'\x89MCAP0\r\n'
+#: Held (flock) by a live BagWriter: a bag with it held is being recorded, not broken.
+WRITER_LOCK = '.writing.lock'
 
 
 class BagError(ValueError):
@@ -154,6 +156,7 @@ class BagWriter:
         self.closed = False
         self.flush_period_s = flush_period_s
         self._flushed_s = time.monotonic()
+        self._lock = _hold_writer_lock(self.path)   # released by the OS if the writer dies
         if flush_period_s is not None:
             self._write_metadata()
 
@@ -240,6 +243,8 @@ class BagWriter:
         if not self.closed:
             self.closed = True
             self._writer.close()
+            self._lock.close()
+            (self.path / WRITER_LOCK).unlink(missing_ok=True)
 
     def __enter__(self) -> 'BagWriter':
         return self
@@ -248,8 +253,32 @@ class BagWriter:
         self.close()
 
 
+def _hold_writer_lock(path: Path):
+    import fcntl
+    handle = (path / WRITER_LOCK).open('w')
+    fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    return handle
+
+
+def being_written(path: str | Path) -> bool:
+    """True while a live BagWriter holds the bag (its lock dies with its process)."""
+    import fcntl
+    lock = Path(path) / WRITER_LOCK
+    if not lock.is_file():
+        return False
+    with lock.open('a') as handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            return True
+        fcntl.flock(handle, fcntl.LOCK_UN)
+    return False
+
+
 def _open_reader(path: str | Path) -> Reader:
     path = Path(path)
+    if being_written(path):
+        raise BagError(f'{path}: still being recorded; open it once the recorder stopped')
     if unfinished_mcap(path) is not None:
         count = recover_bag(path)
         print(f'[bag_io] {path}: its writer died; recovered {count} messages (the file as '
@@ -308,6 +337,7 @@ def recover_bag(path: str | Path) -> int:
         for message in messages:
             writer.write(topics[message.channel_id], message.log_time, message.data)
     source.rename(source.with_name(source.name + '.truncated'))
+    (path / WRITER_LOCK).unlink(missing_ok=True)
     for name in (f'{path.name}.mcap', 'metadata.yaml'):
         (scratch / path.name / name).replace(path / name)
     shutil.rmtree(scratch)

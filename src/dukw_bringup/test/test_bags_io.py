@@ -140,6 +140,8 @@ def test_a_bag_whose_writer_died_is_readable_after_recovery(tmp_path):
                              _traction(store, seq, 0.1 * seq))
     writer.flush()                                                  # what a crash leaves
     writer.write_message('/traction', 'dukw_msgs/msg/Traction', 40, _traction(store, 4, 0.4))
+    with pytest.raises(BagError, match='still being recorded'):
+        summarize(tmp_path / 'live')                               # live: left alone
     shutil.copytree(tmp_path / 'live', tmp_path / 'crashed')       # the folder at the kill
     writer.close()
     assert summarize(tmp_path / 'crashed').message_count == 4      # recovered on open
