@@ -1,11 +1,15 @@
 """Fault matrix, actuator rows (README "Failsafes"): sim_node as a real process stands in
-for the servo switch (the same CommandGate rule), the probe or maneuver_node commands.
+for the servo switch (the same CommandGate rule), the probe or a commander process
+(tests/support/track_commander.py) commands.
 
 Each test: the fault, how it is injected, what must happen and by when (wall time from
 the injection to the simulator's first neutral track command; printed, -s shows it).
 """
 import signal
+import subprocess
+import sys
 import time
+from pathlib import Path
 
 import pytest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
@@ -17,6 +21,7 @@ from dukw_common.testing import NodeProcess, ros_node, spin_until
 
 pytestmark = pytest.mark.ros
 
+COMMANDER = Path(__file__).resolve().parents[1] / 'support' / 'track_commander.py'
 COMMAND_TIMEOUT_S = 0.5          # sim_node / servo_switch_node command_timeout_s (config)
 STATUS_PERIOD_S = 0.05           # tracks/status at 20 Hz: a neutral is seen this much later
 
@@ -124,17 +129,17 @@ def test_rc_takeover_and_link_loss_are_neutral_at_once(probe, rc_selected, rc_li
 def test_a_killed_commander_ends_in_neutral_by_the_command_timeout(probe):
     # last in this module: a SIGKILLed publisher stays in the DDS graph until its lease
     # runs out (about 20 s), and a second commander is refused meanwhile
-    args = ['--ros-args', '-p', 'maneuver:=circle', '-p', 'duration_s:=60.0']
-    commander = NodeProcess('dukw_control', 'maneuver_node', args)
+    commander = subprocess.Popen([sys.executable, str(COMMANDER), '44.0', '100.0'],
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
-        if not probe.spin(lambda: probe.command_pct() not in (None, (0.0, 0.0)), 60.0):
-            commander.stop()
-            pytest.fail(f'{probe.authority[-1]}\n{commander.stderr}')
+        assert probe.spin(lambda: probe.command_pct() == (44.0, 100.0), 60.0), \
+            probe.authority[-1]
         since = time.monotonic()
-        commander.proc.send_signal(signal.SIGKILL)
+        commander.send_signal(signal.SIGKILL)
         reaction = probe.reaction_s(since)
     finally:
-        commander.stop()
+        commander.kill()
+        commander.communicate(timeout=30)
     print(f'commander killed -> neutral: {reaction:.3f} s')
     assert reaction <= COMMAND_TIMEOUT_S + STATUS_PERIOD_S + 0.1
     assert probe.spin(lambda: probe.authority[-1].reason == Authority.REASON_COMMAND_TIMEOUT)
