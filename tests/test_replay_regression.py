@@ -119,8 +119,9 @@ def test_mode_manager_node_through_real_topics_makes_the_recorded_changes():
             spin_until(executor, lambda: False, 0.5)
             player = NodeProcess('dukw_bringup', 'play', [
                 str(bag), '--clock', '--rate', '2',
-                '--topics', 'water/contact', 'depth', 'traction', 'tracks/status',
-                '--wait-for', 'water/contact', 'depth', 'traction', 'tracks/status', 'clock',
+                '--topics', 'water/contact', 'depth', 'traction', 'tracks/status', 'imu/data',
+                '--wait-for', 'water/contact', 'depth', 'traction', 'tracks/status', 'imu/data',
+                'clock',
                 '--wait-timeout', '30'])
             spin_until(executor, lambda: not player.alive() and seen
                        and seen[-1][0] > end_s - 1.0, 90)

@@ -14,6 +14,7 @@ setup(
         # The workspace's parameter files, so installed nodes find their defaults.
         ('share/' + package_name + '/config', glob('config/*.yaml')),
         ('share/' + package_name + '/config/reference', glob('config/reference/*.yaml')),
+        ('share/' + package_name + '/config/sros2', glob('config/sros2/*.xml')),
     ],
     install_requires=['setuptools'],
     zip_safe=True,

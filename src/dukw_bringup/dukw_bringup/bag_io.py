@@ -11,6 +11,9 @@ from __future__ import annotations
 
 import functools
 import os
+import shutil
+import sys
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterable, Iterator, NamedTuple, Sequence
@@ -18,6 +21,8 @@ from typing import Any, Iterable, Iterator, NamedTuple, Sequence
 from rosbags.interfaces import (Connection, Qos, QosDurability, QosHistory, QosLiveliness,
                                 QosReliability, QosTime)
 from rosbags.rosbag2 import CompressionFormat, CompressionMode, Reader, StoragePlugin, Writer
+from rosbags.rosbag2.errors import ReaderError
+from rosbags.rosbag2.metadata import dump_qos_v8, dump_qos_v9, parse_qos
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
@@ -27,6 +32,12 @@ LATCHED_TOPICS = ('authority', 'drive_mode')
 MSG_DIR_ENV = 'DUKW_MSGS_DIR'
 
 _NEVER = QosTime(sec=0, nsec=0)
+#: A live bag's pending MCAP chunk is written out (and metadata.yaml refreshed) this often,
+#: so a recorder killed mid-run loses at most this much (issue 17).
+FLUSH_PERIOD_S = 1.0
+_MCAP_MAGIC = b'\x89MCAP0\r\n'
+#: Held (flock) by a live BagWriter: a bag with it held is being recorded, not broken.
+WRITER_LOCK = '.writing.lock'
 
 
 class BagError(ValueError):
@@ -125,10 +136,14 @@ class BagWriter:
 
     Use as a context manager, or call ``close()`` (idempotent) from a shutdown path.
     ``compress`` zstd-compresses the MCAP chunks (smaller; every MCAP reader handles it).
+    Crash-safe: metadata.yaml is written at once and, with the pending chunk, at least
+    every ``flush_period_s`` of writing, so a writer killed mid-run leaves a bag that
+    ``ros2 bag info`` reads and that ``recover_bag`` (called by this module's readers)
+    turns into a complete one.
     """
 
     def __init__(self, path: str | Path, store: Typestore | None = None,
-                 compress: bool = False) -> None:
+                 compress: bool = False, flush_period_s: float | None = FLUSH_PERIOD_S) -> None:
         self.path = Path(path)
         self.store = store or typestore()
         self._writer = Writer(self.path, version=Writer.VERSION_LATEST,
@@ -139,6 +154,56 @@ class BagWriter:
         self._connections: dict[str, Connection] = {}
         self.counts: dict[str, int] = {}
         self.closed = False
+        self.flush_period_s = flush_period_s
+        self._flushed_s = time.monotonic()
+        self._lock = _hold_writer_lock(self.path)   # released by the OS if the writer dies
+        if flush_period_s is not None:
+            self._write_metadata()
+
+    def flush(self) -> None:
+        """Write the pending chunk to the file and refresh metadata.yaml."""
+        storage = self._writer.storage
+        if self.closed or storage is None:
+            return
+        if storage.chunk.msgs:
+            storage.close_chunk()
+        storage.bio.flush()
+        self._write_metadata()
+        self._flushed_s = time.monotonic()
+
+    def flush_if_due(self) -> None:
+        """``flush`` when ``flush_period_s`` has passed since the last one."""
+        if self.flush_period_s is not None and \
+                time.monotonic() - self._flushed_s >= self.flush_period_s:
+            self.flush()
+
+    def _write_metadata(self) -> None:
+        """metadata.yaml as rosbags writes it on close, for the messages so far."""
+        import yaml
+        w = self._writer
+        count = sum(w.counts.values())
+        start = w.min_timestamp if count else 0
+        duration = max(0, w.max_timestamp - w.min_timestamp) if count else 0
+        dump_qos = dump_qos_v9 if w.version >= 9 else dump_qos_v8
+        name = f'{self.path.name}.mcap'
+        info = {
+            'version': w.version, 'storage_identifier': 'mcap', 'relative_file_paths': [name],
+            'duration': {'nanoseconds': duration},
+            'starting_time': {'nanoseconds_since_epoch': start}, 'message_count': count,
+            'topics_with_message_count': [
+                {'topic_metadata': {'name': c.topic, 'type': c.msgtype,
+                                    'serialization_format': c.ext.serialization_format,
+                                    'offered_qos_profiles': dump_qos(c.ext.offered_qos_profiles),
+                                    'type_description_hash': c.digest},
+                 'message_count': w.counts[c.id]} for c in w.connections],
+            'compression_format': '', 'compression_mode': '',
+            'files': [{'path': name, 'starting_time': {'nanoseconds_since_epoch': start},
+                       'duration': {'nanoseconds': duration}, 'message_count': count}],
+            'custom_data': None, 'ros_distro': 'rosbags'}
+        tmp = self.path / 'metadata.yaml.tmp'
+        tmp.write_text(yaml.safe_dump({'rosbag2_bagfile_information': info},
+                                      default_flow_style=False))
+        tmp.replace(self.path / 'metadata.yaml')
 
     def add_topic(self, topic: str, msgtype: str, qos: Sequence[Qos] = ()) -> None:
         """Declare ``topic`` of ``msgtype``; the type must be in the type store."""
@@ -166,6 +231,7 @@ class BagWriter:
             raise BagError(f'{topic}: add_topic() it before writing')
         self._writer.write(self._connections[topic], int(timestamp_ns), raw)
         self.counts[topic] += 1
+        self.flush_if_due()
 
     def write_message(self, topic: str, msgtype: str, timestamp_ns: int, msg: Any) -> None:
         """Serialize a rosbags message object and append it (adds the topic if new)."""
@@ -177,6 +243,8 @@ class BagWriter:
         if not self.closed:
             self.closed = True
             self._writer.close()
+            self._lock.close()
+            (self.path / WRITER_LOCK).unlink(missing_ok=True)
 
     def __enter__(self) -> 'BagWriter':
         return self
@@ -185,13 +253,95 @@ class BagWriter:
         self.close()
 
 
+def _hold_writer_lock(path: Path):
+    import fcntl
+    handle = (path / WRITER_LOCK).open('w')
+    fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    return handle
+
+
+def being_written(path: str | Path) -> bool:
+    """True while a live BagWriter holds the bag (its lock dies with its process)."""
+    import fcntl
+    lock = Path(path) / WRITER_LOCK
+    if not lock.is_file():
+        return False
+    with lock.open('a') as handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            return True
+        fcntl.flock(handle, fcntl.LOCK_UN)
+    return False
+
+
 def _open_reader(path: str | Path) -> Reader:
     path = Path(path)
+    if being_written(path):
+        raise BagError(f'{path}: still being recorded; open it once the recorder stopped')
+    if unfinished_mcap(path) is not None:
+        count = recover_bag(path)
+        print(f'[bag_io] {path}: its writer died; recovered {count} messages (the file as '
+              'found is kept as *.mcap.truncated)', file=sys.stderr)
     if not (path / 'metadata.yaml').is_file():
         raise BagError(f'{path}: not a rosbag2 folder (no metadata.yaml)')
     reader = Reader(path)
-    reader.open()
+    try:
+        reader.open()
+    except ReaderError as exc:
+        raise BagError(f'{path}: {exc}') from exc
     return reader
+
+
+def unfinished_mcap(path: str | Path) -> Path | None:
+    """The bag folder's MCAP file if its writer never finished it (no footer), else None."""
+    files = sorted(Path(path).glob('*.mcap'))
+    if len(files) != 1 or files[0].stat().st_size < 2 * len(_MCAP_MAGIC):
+        return files[0] if len(files) == 1 else None
+    with files[0].open('rb') as f:
+        f.seek(-len(_MCAP_MAGIC), os.SEEK_END)
+        return None if f.read() == _MCAP_MAGIC else files[0]
+
+
+def recover_bag(path: str | Path) -> int:
+    """Rebuild a bag whose writer died from the complete records of its MCAP (the schemas,
+    channels with their offered QoS, and messages up to the first cut record); the file
+    as found is kept beside it as ``*.mcap.truncated``. Returns the messages recovered."""
+    from mcap.records import Channel, Message, Schema
+    from mcap.stream_reader import StreamReader
+    path = Path(path)
+    source = unfinished_mcap(path)
+    if source is None:
+        raise BagError(f'{path}: no unfinished MCAP file to recover')
+    schemas, channels, messages = {}, {}, []
+    with source.open('rb') as f:
+        try:
+            for record in StreamReader(f).records:
+                if isinstance(record, Schema):
+                    schemas[record.id] = record.name
+                elif isinstance(record, Channel):
+                    channels[record.id] = record
+                elif isinstance(record, Message):
+                    messages.append(record)
+        except Exception:  # noqa: BLE001 -- the cut record at the crash: keep what came before
+            pass
+    scratch = path.parent / f'.{path.name}.recovering'
+    shutil.rmtree(scratch, ignore_errors=True)
+    scratch.mkdir()
+    with BagWriter(scratch / path.name, flush_period_s=None) as writer:
+        topics = {}
+        for cid, channel in channels.items():
+            qos = parse_qos(channel.metadata.get('offered_qos_profiles', ''))
+            writer.add_topic(channel.topic, schemas[channel.schema_id], qos)
+            topics[cid] = channel.topic
+        for message in messages:
+            writer.write(topics[message.channel_id], message.log_time, message.data)
+    source.rename(source.with_name(source.name + '.truncated'))
+    (path / WRITER_LOCK).unlink(missing_ok=True)
+    for name in (f'{path.name}.mcap', 'metadata.yaml'):
+        (scratch / path.name / name).replace(path / name)
+    shutil.rmtree(scratch)
+    return len(messages)
 
 
 def _latched(conn: Connection) -> bool:

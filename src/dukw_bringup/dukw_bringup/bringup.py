@@ -10,7 +10,13 @@ file (config/stack_sim.yaml, config/stack_boat.yaml) lists the nodes:
         - {name: sim_node, package: dukw_sim, executable: sim_node, args: [-p, rate_hz:=100.0]}
 
 ``args`` are ROS arguments (after the parameter files), ``cli_args`` the program's
-own (before ``--ros-args``), ``rename: true`` runs the node under ``name``.
+own (before ``--ros-args``), ``rename: true`` runs the node under ``name``. A stack
+with ``clock_node: sim_node`` runs every other node with ``use_sim_time:=true``
+(as the launch file and the main job do), so stamps and ages share one clock.
+``discovery_range: LOCALHOST`` (both stacks) keeps the ROS graph on the vehicle:
+the nodes get ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` unless the environment
+sets it explicitly (README "Security"). With ``ROS_SECURITY_ENABLE=true`` each
+node runs in its SROS2 enclave ``/dukw/<name>`` (config/sros2/dukw_policy.xml).
 
 Each node runs as ``<prefix>/lib/<package>/<executable> --ros-args
 [-r __node:=<name>] --params-file <file>... <args>`` in its own session (so a
@@ -40,6 +46,10 @@ from dukw_common.config import ConfigError, default_config_path
 
 _NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')
 _PR_SET_PDEATHSIG = 1
+DISCOVERY_ENV = 'ROS_AUTOMATIC_DISCOVERY_RANGE'
+#: SROS2 enclaves of config/sros2/dukw_policy.xml: one per node, /dukw/<node name>
+ENCLAVE_ROOT = '/dukw'
+DISCOVERY_RANGES = ('LOCALHOST', 'SUBNET', 'OFF', 'SYSTEM_DEFAULT')
 
 
 @dataclass(frozen=True)
@@ -60,6 +70,12 @@ class StackSpec:
 
     name: str
     nodes: tuple[NodeSpec, ...]
+    clock_node: str | None = None   # publishes /clock: every other node uses sim time
+    discovery_range: str | None = None   # ROS_AUTOMATIC_DISCOVERY_RANGE unless already set
+
+    def uses_sim_time(self, spec: NodeSpec) -> bool:
+        """Whether ``spec`` runs on the clock node's /clock."""
+        return self.clock_node is not None and spec.name != self.clock_node
 
     def node(self, name: str) -> NodeSpec:
         """The node called ``name``; KeyError if there is none."""
@@ -97,7 +113,15 @@ def parse_stack(doc: Any, source: str = 'stack') -> StackSpec:
     names = [n.name for n in nodes]
     if len(set(names)) != len(names):
         raise ConfigError(f'{source}: node names must be unique, got {names}')
-    return StackSpec(str(tree.get('name', Path(source).stem)), tuple(nodes))
+    clock_node = tree.get('clock_node')
+    if clock_node is not None and clock_node not in names:
+        raise ConfigError(f'{source}: stack.clock_node {clock_node!r} is not one of {names}')
+    discovery = tree.get('discovery_range')
+    if discovery is not None and discovery not in DISCOVERY_RANGES:
+        raise ConfigError(f'{source}: stack.discovery_range must be one of {DISCOVERY_RANGES}, '
+                          f'got {discovery!r}')
+    return StackSpec(str(tree.get('name', Path(source).stem)), tuple(nodes), clock_node,
+                     discovery)
 
 
 def load_stack(path: str | Path) -> StackSpec:
@@ -126,14 +150,19 @@ def node_executable(package: str, executable: str) -> Path:
     return path
 
 
-def node_command(spec: NodeSpec, params_files: Sequence[Path]) -> list[str]:
-    """The command line that runs one node."""
+def node_command(spec: NodeSpec, params_files: Sequence[Path],
+                 sim_time: bool = False, secure: bool = False) -> list[str]:
+    """The command line that runs one node (``secure``: in its SROS2 enclave)."""
     command = [str(node_executable(spec.package, spec.executable)), *spec.cli_args,
                '--ros-args']
     if spec.rename:
         command += ['-r', f'__node:={spec.name}']
+    if secure:
+        command += ['--enclave', f'{ENCLAVE_ROOT}/{spec.name}']
     for params in params_files:
         command += ['--params-file', str(params)]
+    if sim_time:
+        command += ['-p', 'use_sim_time:=true']
     return command + list(spec.args)
 
 
@@ -179,6 +208,8 @@ class Runner:
         self.out = out or sys.stdout
         self.stop_timeout_s = stop_timeout_s
         self.env = {**os.environ, 'PYTHONUNBUFFERED': '1', **(env or {})}
+        if stack.discovery_range and not self.env.get(DISCOVERY_ENV):
+            self.env[DISCOVERY_ENV] = stack.discovery_range
         self.procs: list[NodeProc] = []
         self._lock = threading.Lock()
         self._stopping = False
@@ -186,7 +217,9 @@ class Runner:
     # -- life cycle
     def start(self) -> None:
         """Start every node in order; on a failure stop those already started and re-raise."""
-        commands = [node_command(spec, self.params_files) for spec in self.stack.nodes]
+        secure = self.env.get('ROS_SECURITY_ENABLE', '').lower() == 'true'
+        commands = [node_command(spec, self.params_files, self.stack.uses_sim_time(spec),
+                                 secure) for spec in self.stack.nodes]
         if self.log_dir is not None:
             self.log_dir.mkdir(parents=True, exist_ok=True)
         try:

@@ -226,7 +226,7 @@ def generate(scenario: Scenario, out_dir: Path, config_path: str | None = None) 
     bag = Path(out_dir) / scenario.name
     if bag.exists():
         shutil.rmtree(bag)
-    with BagWriter(bag, compress=True) as writer:
+    with BagWriter(bag, compress=True, flush_period_s=None) as writer:   # same bytes each run
         loop = _Loop(scenario, writer, config_path)
         loop.run()
     size_kb = sum(p.stat().st_size for p in bag.iterdir()) / 1024

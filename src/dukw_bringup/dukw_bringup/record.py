@@ -21,8 +21,12 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.utilities import remove_ros_args
 
-from dukw_bringup.bag_io import BagError, BagWriter, make_qos, topic_key, typestore
-from dukw_common.node_tools import run_node
+from rosbags.interfaces import (Qos, QosDurability, QosHistory, QosLiveliness, QosReliability,
+                                QosTime)
+
+from dukw_bringup.bag_io import BagError, BagWriter, topic_key, typestore
+from dukw_common.config import ConfigError
+from dukw_common.node_tools import check_params_files, run_node
 
 #: Never recorded unless named explicitly: ROS's own chatter.
 IGNORED_BY_DEFAULT = ('/rosout', '/parameter_events')
@@ -70,6 +74,7 @@ class Recorder:
         """Subscribe to every wanted topic that has appeared since the last scan."""
         if self.writer.closed:
             return
+        self.writer.flush_if_due()        # a quiet topic's last messages reach the file too
         for topic, types in self.node.get_topic_names_and_types():
             if topic in self._subscriptions or topic in self._skipped or not self._wants(topic):
                 continue
@@ -92,10 +97,7 @@ class Recorder:
             reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
             durability=(DurabilityPolicy.TRANSIENT_LOCAL if latched
                         else DurabilityPolicy.VOLATILE))
-        self.writer.add_topic(topic, msgtype, [
-            make_qos(reliable=q.reliability == ReliabilityPolicy.RELIABLE,
-                     transient_local=q.durability == DurabilityPolicy.TRANSIENT_LOCAL,
-                     depth=max(1, q.depth)) for q in offered])
+        self.writer.add_topic(topic, msgtype, [offered_qos(q) for q in offered])
         cls = message_class(msgtype)
         self._subscriptions[topic] = self.node.create_subscription(
             cls, topic, lambda raw, t=topic: self._on_message(t, raw), qos, raw=True)
@@ -114,6 +116,21 @@ class Recorder:
             self.node.destroy_subscription(subscription)
         self._subscriptions.clear()
         self.writer.close()
+
+
+def offered_qos(profile: QoSProfile) -> Qos:
+    """A publisher's offered QoS as the graph reports it, every field kept, for the bag
+    (DDS discovery does not carry history and depth: they stay as reported, as rosbag2's)."""
+    def span(duration) -> QosTime:
+        sec, nsec = divmod(int(duration.nanoseconds), 1_000_000_000)
+        return QosTime(sec=sec, nsec=nsec)
+    return Qos(history=QosHistory(int(profile.history)), depth=int(profile.depth),
+               reliability=QosReliability(int(profile.reliability)),
+               durability=QosDurability(int(profile.durability)),
+               deadline=span(profile.deadline), lifespan=span(profile.lifespan),
+               liveliness=QosLiveliness(int(profile.liveliness)),
+               liveliness_lease_duration=span(profile.liveliness_lease_duration),
+               avoid_ros_namespace_conventions=bool(profile.avoid_ros_namespace_conventions))
 
 
 def message_class(msgtype: str):
@@ -165,6 +182,11 @@ def parse_args(argv: Sequence[str]) -> argparse.Namespace:
 def main(argv: Sequence[str] | None = None) -> int:
     """Console-script entry point."""
     argv = list(sys.argv if argv is None else argv)
+    try:
+        check_params_files(argv)
+    except ConfigError as exc:
+        print(f'[FATAL] record: {exc}', file=sys.stderr)
+        return 2
     args = parse_args(remove_ros_args(argv)[1:])
     if args.out.exists():
         print(f'[FATAL] record: {args.out} exists already; give a new folder', file=sys.stderr)

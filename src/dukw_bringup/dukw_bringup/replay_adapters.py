@@ -47,6 +47,11 @@ def _node_params(node_name: str, config_path: str | None) -> dict:
     return node_params(node_name, config_path)
 
 
+def _stamp_or(msg, fallback_s: float) -> float:
+    t_s = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+    return t_s if t_s > 0.0 else fallback_s
+
+
 def _side_row(prefix: str, port: float, stbd: float) -> dict[str, float]:
     return {f'{prefix}.port_pct': float(port), f'{prefix}.stbd_pct': float(stbd)}
 
@@ -61,7 +66,7 @@ class ModeManagerAdapter(CoreAdapter):
     """dukw_control.modes.ModeManager as mode_manager_node drives it."""
 
     name = 'mode_manager'
-    inputs = ('water/contact', 'depth', 'traction', 'tracks/status')
+    inputs = ('water/contact', 'depth', 'traction', 'tracks/status', 'imu/data')
     outputs = ('drive_mode',)
 
     def __init__(self, config_path: str | None = None) -> None:
@@ -79,6 +84,8 @@ class ModeManagerAdapter(CoreAdapter):
             self.core.on_traction(msg.weight_on_tracks_fraction, t_s)
         elif topic == 'tracks/status' and msg.connected:
             self.core.on_track_forces(msg.port.force_n, msg.stbd.force_n, t_s)
+        elif topic == 'imu/data':
+            self.core.on_attitude(_stamp_or(msg, t_s), t_s)
         return None
 
     def tick(self, t_s):
@@ -124,7 +131,7 @@ class DriveControllerAdapter(CoreAdapter):
             if not usable:
                 return self._step(t_s)  # the node goes neutral at once
         elif topic == 'drive_mode':
-            core.on_mode(self.convert.decision_from_msg(msg))
+            core.on_mode(self.convert.decision_from_msg(msg), t_s)
         elif topic == 'odometry/filtered':
             core.on_odometry(msg.twist.twist.linear.x, msg.twist.twist.angular.z, t_s)
             if self.pitch_from_odometry:
@@ -133,8 +140,10 @@ class DriveControllerAdapter(CoreAdapter):
             if self.step_on_odometry:
                 self.last_event_step_s = t_s
                 return self._step(t_s)
-        elif topic == 'imu/data' and not self.pitch_from_odometry:
-            core.on_pitch(self.convert.pitch_from_imu(msg), t_s)
+        elif topic == 'imu/data':
+            core.on_attitude(_stamp_or(msg, t_s), t_s)
+            if not self.pitch_from_odometry:
+                core.on_pitch(self.convert.pitch_from_imu(msg), t_s)
         elif topic == 'traction':
             core.on_slips(msg.port_slip, msg.stbd_slip, t_s)
         elif topic == 'tracks/status' and msg.connected:

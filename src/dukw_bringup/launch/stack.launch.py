@@ -29,12 +29,14 @@ def _nodes(context):
     nodes = []
     for entry in stack['nodes']:
         parameters = [params_file]
-        if sim and entry['executable'] != 'sim_node':
+        if stack.get('clock_node') not in (None, entry['name']):
             parameters.append({'use_sim_time': True})
         nodes.append(Node(
             package=entry['package'], executable=entry['executable'], name=entry['name'],
             parameters=parameters, ros_arguments=[str(a) for a in entry.get('args', [])],
             output='screen', emulate_tty=True,
+            additional_env=({'ROS_AUTOMATIC_DISCOVERY_RANGE': stack['discovery_range']}
+                            if stack.get('discovery_range') else None),
             on_exit=Shutdown(reason=f"{entry['name']} exited")))
     return nodes
 

@@ -126,3 +126,36 @@ def test_mcap_carries_what_foxglove_and_ros2_bag_need(tmp_path):
         (message,) = [m for _, _, m in reader.iter_messages()]
     assert bag_io.typestore().deserialize_cdr(message.data, 'dukw_msgs/msg/Traction'
                                               ).port_slip == 0.5
+
+
+def test_a_bag_whose_writer_died_is_readable_after_recovery(tmp_path):
+    import shutil
+    store = bag_io.typestore()
+    writer = BagWriter(tmp_path / 'live', flush_period_s=3600.0)
+    assert (tmp_path / 'live' / 'metadata.yaml').is_file()          # written at once
+    writer.add_topic('/traction', 'dukw_msgs/Traction',
+                     [bag_io.make_qos(reliable=False, depth=5)])
+    for seq in range(4):
+        writer.write_message('/traction', 'dukw_msgs/msg/Traction', seq * 10,
+                             _traction(store, seq, 0.1 * seq))
+    writer.flush()                                                  # what a crash leaves
+    writer.write_message('/traction', 'dukw_msgs/msg/Traction', 40, _traction(store, 4, 0.4))
+    with pytest.raises(BagError, match='still being recorded'):
+        summarize(tmp_path / 'live')                               # live: left alone
+    shutil.copytree(tmp_path / 'live', tmp_path / 'crashed')       # the folder at the kill
+    writer.close()
+    assert summarize(tmp_path / 'crashed').message_count == 4      # recovered on open
+    messages = list(read_messages(tmp_path / 'crashed'))
+    assert [m.timestamp_ns for m in messages] == [0, 10, 20, 30]
+    assert bag_io.deserialize(messages[3]).port_slip == pytest.approx(0.3)
+    assert [p.name for p in (tmp_path / 'crashed').glob('*.truncated')] == ['live.mcap.truncated']
+    assert not summarize(tmp_path / 'crashed').topics[0].latched
+
+
+def test_a_bag_killed_before_its_first_flush_has_no_messages_but_opens(tmp_path):
+    import shutil
+    writer = BagWriter(tmp_path / 'live')
+    writer.add_topic('/traction', 'dukw_msgs/Traction')
+    shutil.copytree(tmp_path / 'live', tmp_path / 'crashed')
+    writer.close()
+    assert summarize(tmp_path / 'crashed').message_count == 0

@@ -33,6 +33,24 @@ def test_workspace_stacks_parse():
         n.executable for n in boat.nodes}
 
 
+def test_sim_stack_runs_every_node_but_the_simulator_on_sim_time():
+    from dukw_bringup.bringup import node_command
+    for name, expected in (('sim', True), ('boat', False)):
+        stack = load_stack(stack_path(name))
+        for spec in stack.nodes:
+            command = node_command(spec, [], stack.uses_sim_time(spec))
+            on_sim_time = 'use_sim_time:=true' in command
+            assert on_sim_time == (expected and spec.name != 'sim_node'), (name, spec.name)
+
+
+def test_both_stacks_keep_the_ros_graph_on_the_vehicle_unless_told_otherwise():
+    from dukw_bringup.bringup import DISCOVERY_ENV, Runner
+    for name in ('sim', 'boat'):
+        stack = load_stack(stack_path(name))
+        assert Runner(stack, env={DISCOVERY_ENV: ''}).env[DISCOVERY_ENV] == 'LOCALHOST'
+        assert Runner(stack, env={DISCOVERY_ENV: 'SUBNET'}).env[DISCOVERY_ENV] == 'SUBNET'
+
+
 @pytest.mark.parametrize('doc,message', [
     ({}, 'top-level "stack"'),
     ({'stack': {'nodes': []}}, 'non-empty'),
@@ -41,6 +59,10 @@ def test_workspace_stacks_parse():
     ({'stack': {'nodes': [{'name': 'a', 'package': 'p', 'executable': 'e', 'args': 'x'}]}},
      'args'),
     ({'stack': {'nodes': [{'name': 'a', 'package': 'p', 'executable': 'e'}] * 2}}, 'unique'),
+    ({'stack': {'clock_node': 'b', 'nodes': [{'name': 'a', 'package': 'p', 'executable': 'e'}]}},
+     'clock_node'),
+    ({'stack': {'discovery_range': 'WORLD',
+                'nodes': [{'name': 'a', 'package': 'p', 'executable': 'e'}]}}, 'discovery_range'),
 ])
 def test_bad_stack_file_is_refused(doc, message):
     with pytest.raises(ConfigError, match=message):

@@ -14,6 +14,7 @@ from typing import Callable, Sequence
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy,
@@ -21,7 +22,7 @@ from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityP
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.signals import SignalHandlerOptions
 
-from dukw_common.config import ConfigError, ParamValue, node_params
+from dukw_common.config import ConfigError, ParamValue, load_file, node_params
 from dukw_common.diagnostics import Health
 
 #: Sensor streams: best effort, keep last 5 (rclpy's sensor-data profile).
@@ -40,14 +41,16 @@ class ParamSpec:
     """A parameter a node declares: its name, meaning and allowed range.
 
     The default value comes from the stack's parameter file (config/dukw.yaml),
-    never from code; ``--params-file`` and ``-p`` override it as usual.
+    never from code; ``--params-file`` and ``-p`` override it as usual. Nodes build
+    their cores once from these values, so every parameter is read-only at run time:
+    a ``set_parameters`` call is refused ("read-only"), never accepted and ignored.
     """
 
     name: str
     description: str
     min: float | None = None
     max: float | None = None
-    read_only: bool = False
+    read_only: bool = True
 
 
 def declare_parameters(node: Node, specs: Sequence[ParamSpec],
@@ -123,14 +126,22 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
     prints a clear message and exits 2. ``executor_factory`` may give another
     executor; every executor is spun with a timeout.
     """
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    try:
+        check_params_files(sys.argv if args is None else args)
+        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    except (ConfigError, _rclpy.RCLError) as exc:   # e.g. malformed ROS arguments
+        print(f'[FATAL] {exc}', file=sys.stderr)
+        return 2
     stop = threading.Event()
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: stop.set())
     node = None
     code = 0
     try:
-        node = factory()
+        try:
+            node = factory()
+        except _rclpy.RCLError as exc:   # e.g. DDS-Security asked of a DDS without it
+            raise ConfigError(f'cannot create the node: {exc}') from exc
         executor = executor_factory()
         executor.add_node(node)
         while not stop.is_set() and rclpy.ok():
@@ -148,6 +159,17 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
             node.destroy_node()
         rclpy.try_shutdown()
     return code
+
+
+def check_params_files(argv: Sequence[str]) -> None:
+    """Raise ConfigError naming the file if a ``--params-file`` is missing or malformed
+    (rcl would only say RCLError, with a traceback)."""
+    argv = list(argv)
+    for i, arg in enumerate(argv):
+        if arg == '--params-file':
+            if i + 1 >= len(argv):
+                raise ConfigError('--params-file needs a file name')
+            load_file(argv[i + 1])
 
 
 def vehicle_specs(*groups: str) -> list[ParamSpec]:
@@ -195,3 +217,13 @@ def s_to_stamp(t_s: float):
     from builtin_interfaces.msg import Time
     sec = int(t_s // 1)
     return Time(sec=sec, nanosec=int(round((t_s - sec) * 1e9)) % 1_000_000_000)
+
+
+def publisher_sources(node, topic: str) -> tuple[int, tuple[str, ...]]:
+    """How many publishers ``topic`` has in the ROS graph, and (only when more than one,
+    as that costs more) the fully qualified names of their nodes."""
+    count = node.count_publishers(topic)
+    if count <= 1:
+        return count, ()
+    infos = node.get_publishers_info_by_topic(node.resolve_topic_name(topic))
+    return count, tuple(f'{i.node_namespace.rstrip("/")}/{i.node_name}' for i in infos)

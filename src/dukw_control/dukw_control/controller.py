@@ -16,6 +16,7 @@ from typing import Mapping
 
 from dukw_common.config import ParamValue, require
 from dukw_common.diagnostics import Health, Level
+from dukw_common.sources import SourceWatch
 from dukw_common.vehicle import drivetrain_params, limit_params, vehicle_params
 
 from dukw_control.guards import InclineGuard, InclineState, StuckDetector
@@ -46,8 +47,8 @@ NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
     ('yaw_ki', 'yaw-rate PI integral gain, 1/s', 0.0, 10.0),
     ('yaw_integral_limit_rps', 'yaw-rate PI integral clamp, rad/s', 0.0, 5.0),
     ('odometry_timeout_s', 'older odometry: open loop, s', 0.01, 10.0),
-    ('imu_timeout_s', 'older pitch (odometry/filtered): tracks neutral (incline unguarded), s',
-     0.01, 10.0),
+    ('imu_timeout_s', 'older attitude (imu/data) or pitch (odometry/filtered): tracks neutral '
+     '(incline unguarded), s', 0.01, 10.0),
     ('tracks_status_timeout_s', 'older tracks/status: tracks neutral (current unguarded), s',
      0.01, 10.0),
     ('traction_timeout_s', 'older traction: stuck detection off, s', 0.01, 10.0),
@@ -188,6 +189,7 @@ class _Inputs:
     authority_ok: bool = False
     authority_detail: str = 'no authority message yet'
     authority_back_s: float = -math.inf
+    stopped_s: float = -math.inf      # last cycle of a safe stop or a stale-input stop
     mode: ModeDecision | None = None
     odom: tuple[float, float] = (0.0, 0.0)
     stamps: dict[str, float] = field(default_factory=dict)
@@ -218,6 +220,7 @@ class DriveController:
         self.stuck = StuckDetector(settings.stuck_slip_threshold,
                                    settings.stuck_speed_threshold_mps,
                                    settings.stuck_min_command_pct, settings.stuck_hold_s)
+        self.sources = SourceWatch()      # drive_mode and authority: one publisher each
         self._last_step_s: float | None = None
         self._last_mix_flags = (False, False)   # (speed, yaw) saturated last cycle
         self.output = ControlOutput(neutral_reason='starting')
@@ -245,8 +248,15 @@ class DriveController:
             self._reset()
         self.i.authority_ok, self.i.authority_detail = usable, detail
 
-    def on_mode(self, decision: ModeDecision) -> None:
-        """The mode manager's latest decision."""
+    def on_mode(self, decision: ModeDecision, now_s: float | None = None) -> None:
+        """The mode manager's latest decision, arrived at ``now_s``.
+
+        A safe stop, and the end of one, count as stops even between two control steps:
+        only a cmd_vel that arrives after them drives again.
+        """
+        modes = (decision.mode, self.i.mode.mode if self.i.mode else None)
+        if now_s is not None and Mode.SAFE_STOP in modes:
+            self.i.stopped_s = max(self.i.stopped_s, now_s)
         self.i.mode = decision
 
     def on_odometry(self, surge_mps: float, yaw_rate_rps: float, now_s: float) -> None:
@@ -259,11 +269,20 @@ class DriveController:
         """REP 103 pitch (positive nose down), low-passed into the nose-up incline."""
         if not math.isfinite(pitch_rad):
             return
-        last = self.i.stamps.get('imu')
+        last = self.i.stamps.get('pitch')
         dt = 0.0 if last is None else min(max(now_s - last, 0.0), 1.0)
         alpha = 1.0 if last is None else dt / (self.s.incline_pitch_time_constant_s + dt + 1e-9)
         self.i.incline_rad += alpha * (-pitch_rad - self.i.incline_rad)
-        self.i.stamps['imu'] = now_s
+        self.i.stamps['pitch'] = now_s
+
+    def on_attitude(self, measured_s: float, now_s: float) -> None:
+        """An IMU attitude sample measured at ``measured_s`` arrived at ``now_s``.
+
+        The pitch comes through the estimator, which keeps predicting while the IMU is
+        silent, so only the IMU's own samples say how old the attitude is.
+        """
+        if math.isfinite(measured_s):
+            self.i.stamps['imu'] = min(measured_s, now_s)
 
     def on_track_currents(self, port_a: float, stbd_a: float, now_s: float) -> None:
         """Track motor currents: advance each motor's I2t account."""
@@ -296,6 +315,11 @@ class DriveController:
         self.output = ControlOutput(neutral_reason=reason)
         return self.output
 
+    def _stopped(self, reason: str, now_s: float) -> ControlOutput:
+        """Neutral for a fault; driving resumes only on a cmd_vel sent after it."""
+        self.i.stopped_s = now_s
+        return self._neutral(reason)
+
     def step(self, now_s: float) -> ControlOutput:
         """Run one control cycle at ``now_s`` and return the commands."""
         s, i = self.s, self.i
@@ -303,19 +327,24 @@ class DriveController:
         self._last_step_s = now_s
         if not i.authority_ok:
             return self._neutral(f'no authority: {i.authority_detail}')
+        if self.sources.fault():
+            return self._stopped(f'second source: {self.sources.fault()}', now_s)
         if i.mode is None or i.mode.mode == Mode.SAFE_STOP:
             self.track_weight.reset()
             self.prop_weight.reset()
-            return self._neutral('safe stop: ' + (i.mode.reason if i.mode else 'no drive_mode'))
+            return self._stopped('safe stop: ' + (i.mode.reason if i.mode else 'no drive_mode'),
+                                 now_s)
         if i.mode.track_weight > 0.0 or i.mode.tracks_idle:
             for name, limit in (('tracks/status', s.tracks_status_timeout_s),
-                                ('imu', s.imu_timeout_s)):
+                                ('imu', s.imu_timeout_s), ('pitch', s.imu_timeout_s)):
                 if self._age(name, now_s) > limit:
-                    return self._neutral(f'{name} stale: the tracks cannot be guarded')
+                    return self._stopped(f'{name} stale: the tracks cannot be guarded', now_s)
         if math.isinf(i.cmd_s):
             return self._neutral('no cmd_vel yet')
         if i.cmd_s < i.authority_back_s:
             return self._neutral('waiting for a fresh cmd_vel since authority came back')
+        if i.cmd_s <= i.stopped_s:
+            return self._neutral('waiting for a fresh cmd_vel since the stop')
         left_s = s.cmd_timeout_s - (now_s - i.cmd_s)
         fade = min(max(left_s / s.timeout_ramp_s, 0.0), 1.0)
         if left_s <= 1e-9:
@@ -410,7 +439,7 @@ class DriveController:
             ctrl.worsen(Level.WARN, f'rejected {i.rejected} cmd_vel ({i.last_rejection})')
         if self.s.closed_loop and self._age('odometry', now_s) > self.s.odometry_timeout_s:
             ctrl.worsen(Level.WARN, 'odometry/filtered stale: open loop')
-        if 'stale' in self.output.neutral_reason:
+        if 'stale' in self.output.neutral_reason or self.sources.fault():
             ctrl.worsen(Level.ERROR, self.output.neutral_reason)
         current = Health('current limiter')
         for side, lim in self.current.items():
@@ -426,6 +455,10 @@ class DriveController:
             'steep_for_s': f'{self.incline.steep_for_s:.1f}'})
         if self.incline.state != InclineState.OK:
             incline.level = Level.WARN
+        stale = [n for n in ('imu', 'pitch') if self._age(n, now_s) > self.s.imu_timeout_s]
+        if stale:                      # never "ok" on an attitude nobody measured lately
+            incline.worsen(Level.ERROR, f'{" and ".join(stale)} stale: incline unguarded, '
+                                        'tracks neutral')
         stuck = Health('stuck detection', values={'slips': _pair(SidePair(*i.slips))})
         if self.stuck.stuck:
             stuck.worsen(Level.ERROR, self.stuck.reason)

@@ -76,3 +76,10 @@ class ActuatorPublishers:
 def pitch_from_quaternion(q) -> float:
     """REP 103 pitch (positive nose down) from a geometry_msgs/Quaternion."""
     return euler_from_quaternion(q.x, q.y, q.z, q.w)[1]
+
+
+def stamp_or(msg, fallback_s: float) -> float:
+    """The header stamp in seconds, or ``fallback_s`` when it is unset (zero)."""
+    stamp = msg.header.stamp
+    t_s = stamp.sec + stamp.nanosec * 1e-9
+    return t_s if t_s > 0.0 else fallback_s

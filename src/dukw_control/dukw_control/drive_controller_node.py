@@ -8,14 +8,15 @@ from dukw_msgs.msg import Authority, DrivetrainStatus, DriveMode, Traction
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
+from sensor_msgs.msg import Imu
 
 from dukw_common.config import ConfigError
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
-                                    declare_parameters, diagnostic_array, run_node,
-                                    vehicle_specs)
+                                    declare_parameters, diagnostic_array, publisher_sources,
+                                    run_node, vehicle_specs)
 from dukw_control.controller import NODE_PARAMS, DriveController, settings_from_params
 from dukw_control.convert import (ActuatorPublishers, authority_usable, decision_from_msg,
-                                  pitch_from_quaternion)
+                                  pitch_from_quaternion, stamp_or)
 
 
 class DriveControllerNode(Node):
@@ -37,6 +38,7 @@ class DriveControllerNode(Node):
         self.create_subscription(Authority, 'authority', self.on_authority, STATE_QOS)
         self.create_subscription(DriveMode, 'drive_mode', self.on_mode, STATE_QOS)
         self.create_subscription(Odometry, 'odometry/filtered', self.on_odometry, SENSOR_QOS)
+        self.create_subscription(Imu, 'imu/data', self.on_imu, SENSOR_QOS)
         self.create_subscription(Traction, 'traction', self.on_traction, SENSOR_QOS)
         self.create_subscription(DrivetrainStatus, 'tracks/status', self.on_tracks, SENSOR_QOS)
         self.create_subscription(DrivetrainStatus, 'props/status', self.on_props, SENSOR_QOS)
@@ -58,13 +60,15 @@ class DriveControllerNode(Node):
                                    throttle_duration_sec=1.0)
 
     def on_authority(self, msg: Authority) -> None:
+        self.core.sources.update('authority', *publisher_sources(self, 'authority'))
         usable, detail = authority_usable(msg)
         self.core.on_authority(usable, detail, self.now_s())
         if not usable:
             self.on_timer()          # neutral at once, not at the next tick
 
     def on_mode(self, msg: DriveMode) -> None:
-        self.core.on_mode(decision_from_msg(msg))
+        self.core.sources.update('drive_mode', *publisher_sources(self, 'drive_mode'))
+        self.core.on_mode(decision_from_msg(msg), self.now_s())
 
     def on_odometry(self, msg: Odometry) -> None:
         now = self.now_s()
@@ -73,6 +77,10 @@ class DriveControllerNode(Node):
         if self.step_on_odometry:
             self.last_event_step_s = now
             self.on_timer()
+
+    def on_imu(self, msg: Imu) -> None:
+        now = self.now_s()
+        self.core.on_attitude(stamp_or(msg, now), now)
 
     def on_tick(self) -> None:
         if self.now_s() - self.last_event_step_s >= 1.5 * self.period_s:

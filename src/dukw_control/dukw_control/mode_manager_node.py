@@ -8,12 +8,14 @@ from diagnostic_msgs.msg import DiagnosticArray
 from dukw_msgs.msg import Depth, DrivetrainStatus, DriveMode, Traction, WaterContact
 from dukw_msgs.srv import SetMode
 from rclpy.node import Node
+from sensor_msgs.msg import Imu
 
 from dukw_common.config import ConfigError
 from dukw_common.diagnostics import Health, Level
+from dukw_common.sources import SourceWatch
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
                                     declare_parameters, diagnostic_array, run_node)
-from dukw_control.convert import decision_to_msg
+from dukw_control.convert import decision_to_msg, stamp_or
 from dukw_control.modes import NODE_PARAMS, Mode, ModeManager, settings_from_params
 
 
@@ -29,6 +31,7 @@ class ModeManagerNode(Node):
         except ValueError as exc:
             raise ConfigError(f'mode_manager_node: {exc}') from exc
         self.republish_period_s = params['republish_period_s']
+        self.sources = SourceWatch()          # set_mode: one client, the operator's
         self.last_publish_s = -1e9
         self.mode_pub = self.create_publisher(DriveMode, 'drive_mode', STATE_QOS)
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
@@ -36,6 +39,7 @@ class ModeManagerNode(Node):
         self.create_subscription(Depth, 'depth', self.on_depth, SENSOR_QOS)
         self.create_subscription(Traction, 'traction', self.on_traction, SENSOR_QOS)
         self.create_subscription(DrivetrainStatus, 'tracks/status', self.on_tracks, SENSOR_QOS)
+        self.create_subscription(Imu, 'imu/data', self.on_imu, SENSOR_QOS)
         self.create_service(SetMode, 'set_mode', self.on_set_mode)
         self.create_timer(1.0 / params['rate_hz'], self.on_timer)
         self.create_timer(1.0, self.publish_diagnostics)
@@ -57,14 +61,28 @@ class ModeManagerNode(Node):
         if msg.connected:
             self.core.on_track_forces(msg.port.force_n, msg.stbd.force_n, self.now_s())
 
+    def on_imu(self, msg: Imu) -> None:
+        now = self.now_s()
+        self.core.on_attitude(stamp_or(msg, now), now)
+
     def on_set_mode(self, request: SetMode.Request, response: SetMode.Response):
+        if self.sources.update('set_mode', self.count_clients('set_mode')) or \
+                self.sources.fault():
+            self.publish_diagnostics()
+        if self.sources.fault():            # no one can tell which client is the operator
+            response.success, response.message = False, f'refused: {self.sources.fault()}'
+            self.get_logger().error(f'set_mode {response.message}')
+            return response
         if request.automatic:
             self.core.release(self.now_s())
         else:
             try:
-                self.core.force(Mode(request.mode), self.now_s())
+                refusal = self.core.force(Mode(request.mode), self.now_s())
             except ValueError:
-                response.success, response.message = False, f'unknown mode {request.mode}'
+                refusal = f'unknown mode {request.mode}'
+            if refusal:
+                self.get_logger().warn(f'set_mode: {refusal}')
+                response.success, response.message = False, refusal
                 return response
         self.on_timer()
         decision = self.core.decision()
@@ -94,6 +112,8 @@ class ModeManagerNode(Node):
             **{f'{k}_age_s': f'{v:.2f}' for k, v in self.core.input_ages(now).items()}})
         if decision.mode == Mode.SAFE_STOP:
             health.level = Level.ERROR
+        if self.sources.fault():
+            health.worsen(Level.ERROR, self.sources.fault())
         elif not decision.automatic:
             health.level = Level.WARN
             stale = self.core.stale_inputs(now)

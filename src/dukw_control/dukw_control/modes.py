@@ -8,8 +8,13 @@ evidence held for a debounce time, entry and exit thresholds differ
 (hysteresis), and a mode is kept for a minimum dwell time, so waves washing
 over the sensors do not make it chatter. The order is always
 LAND <-> TRANSITION <-> WATER; a needed input going stale gives SAFE_STOP.
-An operator's forced mode holds regardless of the inputs (that is what forcing is
-for, e.g. with a broken water sensor); staleness then only shows in diagnostics.
+The IMU's attitude is a needed input too: the estimator keeps predicting while
+the IMU is silent, so its own samples are watched.
+
+An operator's forced mode may only make things safer than the automatic decision:
+SAFE_STOP can always be forced; any other mode is refused (and a held one dropped
+back to automatic) while a needed input is stale, WATER needs water evidence (a wet
+sensor or a valid depth) and LAND is refused while the evidence says afloat.
 """
 from __future__ import annotations
 
@@ -55,6 +60,7 @@ NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
     ('traction_timeout_s', 'older traction: safe stop, s', 0.01, 60.0),
     ('tracks_status_timeout_s', 'older tracks/status: safe stop, s', 0.01, 60.0),
     ('depth_timeout_s', 'older depth counts as not valid, s', 0.01, 60.0),
+    ('imu_timeout_s', 'older imu/data (attitude): safe stop, s', 0.01, 60.0),
 )
 
 
@@ -89,6 +95,7 @@ class ModeSettings:
     traction_timeout_s: float
     tracks_status_timeout_s: float
     depth_timeout_s: float
+    imu_timeout_s: float
 
     def __post_init__(self) -> None:
         fractions = (self.water_enter_fraction, self.water_exit_fraction,
@@ -197,21 +204,47 @@ class ModeManager:
         self._stamps['tracks/status'] = now_s
         return True
 
-    # --- operator ---------------------------------------------------------------------
-    def force(self, mode: Mode, now_s: float) -> None:
-        """Hold ``mode`` until ``release``; the inputs no longer decide (operator's call)."""
-        self._forced = Mode(mode)
-        self._enter(self._forced, now_s, f'forced to {self._forced.name} by the operator')
+    def on_attitude(self, measured_s: float, now_s: float) -> None:
+        """An IMU attitude sample measured at ``measured_s`` arrived at ``now_s``."""
+        if math.isfinite(measured_s):
+            self._stamps['imu'] = min(measured_s, now_s)
 
-    def release(self, now_s: float) -> None:
+    # --- operator ---------------------------------------------------------------------
+    def force(self, mode: Mode, now_s: float) -> str:
+        """Hold ``mode`` until ``release`` if it is no less safe than the evidence allows.
+
+        Returns "" when accepted, else why it was refused (nothing changes then).
+        """
+        mode = Mode(mode)
+        refusal = self.refusal(mode, now_s)
+        if refusal:
+            return refusal
+        self._forced = mode
+        self._enter(mode, now_s, f'forced to {mode.name} by the operator')
+        return ''
+
+    def refusal(self, mode: Mode, now_s: float) -> str:
+        """Why forcing ``mode`` now would be less safe than the evidence ("" if it is not)."""
+        if mode == Mode.SAFE_STOP:
+            return ''
+        stale = self.stale_inputs(now_s)
+        if stale:
+            return f'{mode.name} refused: {stale}'
+        if mode == Mode.WATER and not (self.fore_wet or self.aft_wet or self._depth_ok(now_s)):
+            return 'WATER refused: both water sensors dry and no valid depth'
+        if mode == Mode.LAND and self._classify()[0] == Mode.WATER:
+            return f'LAND refused: {self._classify()[1]}'
+        return ''
+
+    def release(self, now_s: float, why_prefix: str = '') -> None:
         """Return to automatic decisions, starting from the mode the evidence shows now."""
         self._forced = None
         stale = self.stale_inputs(now_s)
         if stale:
-            self._enter(Mode.SAFE_STOP, now_s, f'back to automatic; {stale}')
+            self._enter(Mode.SAFE_STOP, now_s, f'{why_prefix}back to automatic; {stale}')
         else:
             mode, why = self._classify()
-            self._enter(mode, now_s, f'back to automatic: {why}')
+            self._enter(mode, now_s, f'{why_prefix}back to automatic: {why}')
 
     @property
     def automatic(self) -> bool:
@@ -226,7 +259,7 @@ class ModeManager:
     # --- decision ---------------------------------------------------------------------
     def input_ages(self, now_s: float) -> dict[str, float]:
         """Seconds since each input last arrived (inf if never)."""
-        names = ('water/contact', 'traction', 'tracks/status', 'depth')
+        names = ('water/contact', 'traction', 'tracks/status', 'depth', 'imu')
         return {n: now_s - self._stamps.get(n, -math.inf) for n in names}
 
     def stale_inputs(self, now_s: float) -> str:
@@ -234,7 +267,8 @@ class ModeManager:
         ages = self.input_ages(now_s)
         limits = {'water/contact': self.s.water_contact_timeout_s,
                   'traction': self.s.traction_timeout_s,
-                  'tracks/status': self.s.tracks_status_timeout_s}
+                  'tracks/status': self.s.tracks_status_timeout_s,
+                  'imu': self.s.imu_timeout_s}
         never = [n for n in limits if math.isinf(ages[n])]
         if never:
             return 'waiting for ' + ', '.join(never)
@@ -274,6 +308,10 @@ class ModeManager:
         """Decide the mode at ``now_s``; ``changed`` turns True when mode or reason changed."""
         if self._forced is None:
             self._decide(now_s)
+        else:
+            refusal = self.refusal(self._forced, now_s)
+            if refusal:
+                self.release(now_s, f'forcing dropped ({refusal}); ')
         return self.decision()
 
     def _decide(self, now_s: float) -> None:

@@ -107,6 +107,8 @@ class ClosedLoop:
         tr, c, m = self.truth, self.ctrl, self.modes
         c.on_odometry(tr.surge_mps, tr.yaw_rate_rps, t)
         c.on_pitch(tr.pitch_rad, t)
+        c.on_attitude(t, t)
+        m.on_attitude(t, t)
         c.on_slips(tr.port_slip, tr.stbd_slip, t)
         if self.k % STATUS_EVERY == 0:
             c.on_track_currents(tr.port_current_a, tr.stbd_current_a, t)
@@ -122,6 +124,8 @@ class ClosedLoop:
             kind = type(reading).__name__
             if kind == 'ImuReading':
                 c.on_pitch(euler_from_quaternion(*reading.orientation_xyzw)[1], t)
+                c.on_attitude(t, t)
+                m.on_attitude(t, t)
             elif kind == 'WaterContactReading':
                 m.on_water_contact(reading.fore_wet, reading.aft_wet, t)
             elif kind == 'DepthReading':

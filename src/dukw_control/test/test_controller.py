@@ -4,6 +4,7 @@ import math
 
 import pytest
 
+from dukw_common.diagnostics import Level
 from dukw_control.controller import DriveController
 from dukw_control.modes import Mode, ModeDecision
 
@@ -23,6 +24,7 @@ class Rig:
         self.c.on_authority(True, 'computer', self.t)
         self.current_a = 20.0
         self.pitch_rad = 0.0
+        self.imu_alive = True
         self.odom = None
 
     def run(self, seconds, cmd=(1.0, 0.0), send_cmd=True):
@@ -33,6 +35,8 @@ class Rig:
                 self.c.on_cmd_vel(*cmd, self.t)
             self.c.on_track_currents(self.current_a, self.current_a, self.t)
             self.c.on_pitch(self.pitch_rad, self.t)
+            if self.imu_alive:
+                self.c.on_attitude(self.t, self.t)
             self.c.on_slips(0.1, 0.1, self.t)
             if self.odom is not None:
                 self.c.on_odometry(*self.odom, self.t)
@@ -48,6 +52,7 @@ def test_no_authority_no_mode_or_no_cmd_means_neutral(controller_settings):
     c.on_mode(LAND)
     c.on_track_currents(0, 0, 0.02)
     c.on_pitch(0, 0.02)
+    c.on_attitude(0.02, 0.02)
     assert c.step(0.02).neutral_reason == 'no cmd_vel yet'
 
 
@@ -129,6 +134,55 @@ def test_safe_stop_mode_is_neutral(controller_settings):
     assert out.tracks.is_neutral() and 'traction stale' in out.neutral_reason
 
 
+def test_safe_stop_needs_a_cmd_vel_sent_after_it(controller_settings):
+    r = Rig(controller_settings)
+    r.run(2.0)
+    r.c.on_mode(ModeDecision(Mode.SAFE_STOP, True, 0.0, 0.0, False, 'traction stale'))
+    r.run(0.1, send_cmd=False)
+    r.c.on_mode(LAND)                                     # the input came back
+    out = r.run(0.1, send_cmd=False)                      # the old request is not resumed
+    assert out.tracks.is_neutral() and 'since the stop' in out.neutral_reason
+    assert not r.run(0.5).tracks.is_neutral()
+
+
+def test_a_safe_stop_between_two_steps_still_needs_a_fresh_cmd_vel(controller_settings):
+    r = Rig(controller_settings)
+    r.run(2.0)
+    r.c.on_mode(ModeDecision(Mode.SAFE_STOP, True, 0.0, 0.0, False, 'forced'), r.t + 0.002)
+    r.c.on_mode(LAND, r.t + 0.004)                        # never seen by a step
+    r.t += DT
+    out = r.c.step(r.t)
+    assert out.tracks.is_neutral() and 'since the stop' in out.neutral_reason
+
+
+def test_a_silent_imu_stops_the_tracks_although_pitch_keeps_coming(controller_settings):
+    r = Rig(controller_settings)
+    assert not r.run(2.0).tracks.is_neutral()
+    r.imu_alive = False                                   # the estimator keeps predicting
+    out = r.run(controller_settings.imu_timeout_s + 2 * DT)
+    assert out.tracks.is_neutral() and out.neutral_reason.startswith('imu stale')
+    incline = next(h for h in r.c.healths(r.t) if h.name == 'incline guard')
+    assert incline.level == Level.ERROR and 'imu stale' in incline.message
+    r.c.on_attitude(r.t - 5.0, r.t)                       # a sample measured long ago
+    assert r.c.step(r.t).tracks.is_neutral()
+    r.imu_alive = True
+    out = r.run(0.1, send_cmd=False)
+    assert out.tracks.is_neutral()                        # back, but waiting for a request
+    assert not r.run(0.5).tracks.is_neutral()
+
+
+def test_a_second_drive_mode_publisher_stops_and_reports_error(controller_settings):
+    r = Rig(controller_settings)
+    assert not r.run(1.0).tracks.is_neutral()
+    r.c.sources.update('drive_mode', 2, ('/mode_manager_node', '/stranger'))
+    out = r.run(DT)
+    assert out.tracks.is_neutral() and '/stranger' in out.neutral_reason
+    assert r.c.healths(r.t)[0].level == Level.ERROR
+    r.c.sources.update('drive_mode', 1)
+    assert r.run(0.1, send_cmd=False).tracks.is_neutral()
+    assert not r.run(0.5).tracks.is_neutral()
+
+
 def test_stale_imu_or_current_stops_the_tracks(controller_settings):
     r = Rig(controller_settings)
     r.run(2.0)
@@ -167,6 +221,7 @@ def test_stuck_stops_and_reports_until_a_stop_or_reversal(controller_settings):
         r.c.on_cmd_vel(1.0, 0.0, r.t)
         r.c.on_track_currents(20, 20, r.t)
         r.c.on_pitch(0, r.t)
+        r.c.on_attitude(r.t, r.t)
         r.c.on_slips(1.0, 1.0, r.t)
         r.c.on_odometry(0.0, 0.0, r.t)
         out = r.c.step(r.t)

@@ -16,9 +16,12 @@ class Feed:
         self.t = 0.0
         self.modes = []
 
-    def run(self, seconds, fraction=1.0, fore=False, aft=False, depth=False, force_n=200.0):
+    def run(self, seconds, fraction=1.0, fore=False, aft=False, depth=False, force_n=200.0,
+            imu=True):
         for _ in range(int(round(seconds / DT))):
             self.t += DT
+            if imu:
+                self.mm.on_attitude(self.t, self.t)
             self.mm.on_water_contact(fore, aft, self.t)
             self.mm.on_traction(fraction, self.t)
             self.mm.on_track_forces(force_n, force_n, self.t)
@@ -100,12 +103,45 @@ def test_nan_weight_fraction_is_rejected(mode_settings):
 
 def test_forced_mode_holds_and_release_returns_to_the_evidence(mode_settings):
     f = Feed(mode_settings)
-    f.run(1.0)
-    f.mm.force(Mode.WATER, f.t)
-    d = f.run(2.0)
-    assert d.mode == Mode.WATER and not d.automatic and 'forced' in d.reason
+    f.run(1.0, fore=True)                    # a sensor stuck wet keeps it in the transition
+    assert f.mm.force(Mode.LAND, f.t) == ''
+    d = f.run(2.0, fore=True)
+    assert d.mode == Mode.LAND and not d.automatic and 'forced' in d.reason
     f.mm.release(f.t)
-    assert f.mm.decision().mode == Mode.LAND and f.mm.automatic
+    assert f.mm.decision().mode == Mode.TRANSITION and f.mm.automatic
+
+
+def test_a_silent_imu_is_a_safe_stop(mode_settings):
+    f = Feed(mode_settings)
+    assert f.run(1.0).mode == Mode.LAND
+    d = f.run(mode_settings.imu_timeout_s + 2 * DT, imu=False)
+    assert d.mode == Mode.SAFE_STOP and 'imu stale' in d.reason
+    assert f.run(0.2).mode == Mode.LAND
+
+
+def test_forcing_may_only_make_things_safer(mode_settings):
+    f = Feed(mode_settings)
+    f.run(1.0)
+    before = f.mm.decision()
+    refusal = f.mm.force(Mode.WATER, f.t)    # on dry sand
+    assert 'WATER refused' in refusal and f.mm.decision() == before and f.mm.automatic
+    f.run(0.1, fraction=0.0, fore=True, aft=True, depth=True, force_n=0.0)
+    f.run(3.0, fraction=0.0, fore=True, aft=True, depth=True, force_n=0.0)
+    assert 'LAND refused' in f.mm.force(Mode.LAND, f.t)   # afloat
+    f.run(1.0, imu=False)                    # an input goes stale: safe stop ...
+    assert f.mm.decision().mode == Mode.SAFE_STOP
+    for mode in (Mode.LAND, Mode.TRANSITION, Mode.WATER):   # ... that no forcing lifts
+        assert 'refused: imu stale' in f.mm.force(mode, f.t)
+    assert f.mm.force(Mode.SAFE_STOP, f.t) == ''
+
+
+def test_a_held_forced_mode_drops_when_an_input_goes_stale(mode_settings):
+    f = Feed(mode_settings)
+    f.run(1.0)
+    assert f.mm.force(Mode.TRANSITION, f.t) == ''
+    d = f.run(mode_settings.water_contact_timeout_s + 2 * DT, imu=False)
+    assert d.mode == Mode.SAFE_STOP and d.automatic
+    assert 'forcing dropped (TRANSITION refused: imu stale' in f.modes[-1][2]
 
 
 def test_tracks_idle_afloat_is_a_parameter(mode_settings):

@@ -7,6 +7,7 @@ from dukw_msgs.msg import WaterContact
 from dukw_msgs.srv import SetMode
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
+from sensor_msgs.msg import Imu
 
 from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS, stamp_to_s
 from dukw_common.testing import NodeProcess, ros_node, spin_until
@@ -27,6 +28,13 @@ def tracks_status(current_a=10.0, force_n=100.0):
     return msg
 
 
+def imu_now(node):
+    msg = Imu()
+    msg.header.stamp = node.get_clock().now().to_msg()
+    msg.orientation.w = 1.0
+    return msg
+
+
 class Probe:
     """Publishes the controller's inputs and records tracks/cmd."""
 
@@ -35,7 +43,7 @@ class Probe:
         self.pubs = {name: node.create_publisher(kind, name, qos) for name, kind, qos in (
             ('authority', Authority, STATE_QOS), ('drive_mode', DriveMode, STATE_QOS),
             ('cmd_vel', Twist, COMMAND_QOS), ('odometry/filtered', Odometry, SENSOR_QOS),
-            ('tracks/status', DrivetrainStatus, SENSOR_QOS))}
+            ('tracks/status', DrivetrainStatus, SENSOR_QOS), ('imu/data', Imu, SENSOR_QOS))}
         self.tracks = []
         node.create_subscription(DiffCommand, 'tracks/cmd', self.tracks.append, COMMAND_QOS)
         self.sending_cmd = True
@@ -50,6 +58,7 @@ class Probe:
         odom.pose.pose.orientation.w = 1.0
         self.pubs['odometry/filtered'].publish(odom)
         self.pubs['tracks/status'].publish(tracks_status())
+        self.pubs['imu/data'].publish(imu_now(self.node))
         if self.sending_cmd:
             twist = Twist()
             twist.linear.x = 1.0
@@ -97,9 +106,10 @@ def test_mode_manager_publishes_land_and_obeys_set_mode():
         node.create_subscription(DriveMode, 'drive_mode', modes.append, STATE_QOS)
         pubs = {name: node.create_publisher(kind, name, SENSOR_QOS) for name, kind in (
             ('water/contact', WaterContact), ('traction', Traction),
-            ('tracks/status', DrivetrainStatus))}
+            ('tracks/status', DrivetrainStatus), ('imu/data', Imu))}
 
         def feed():
+            pubs['imu/data'].publish(imu_now(node))
             pubs['water/contact'].publish(WaterContact())
             pubs['traction'].publish(Traction(weight_on_tracks_fraction=1.0))
             pubs['tracks/status'].publish(tracks_status())
@@ -113,8 +123,13 @@ def test_mode_manager_publishes_land_and_obeys_set_mode():
             assert client.wait_for_service(timeout_sec=10.0)
             future = client.call_async(SetMode.Request(mode=DriveMode.WATER, automatic=False))
             assert spin_until(executor, future.done, 10.0)
+            assert not future.result().success                    # WATER on dry sand
+            assert 'WATER refused' in future.result().message
+            future = client.call_async(SetMode.Request(mode=DriveMode.SAFE_STOP,
+                                                       automatic=False))
+            assert spin_until(executor, future.done, 10.0)
             assert future.result().success
-            assert spin_until(executor, lambda: modes[-1].mode == DriveMode.WATER, 5.0)
+            assert spin_until(executor, lambda: modes[-1].mode == DriveMode.SAFE_STOP, 5.0)
             assert not modes[-1].automatic and 'forced' in modes[-1].reason
             future = client.call_async(SetMode.Request(automatic=True))
             assert spin_until(executor, future.done, 10.0)

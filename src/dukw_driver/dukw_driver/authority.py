@@ -5,12 +5,16 @@ the RC operator always wins and nothing in software can take authority from the
 RC side. Computer commands reach the motors only while the computer holds
 authority AND they are fresh; otherwise the computer-side outputs are neutral.
 Losing the RC link is a fail-safe: outputs neutral, whoever held authority.
+A command topic with more than one publisher is refused (dukw_common.sources):
+outputs neutral until only one is left, as no one can tell which is genuine.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
 from enum import IntEnum
+
+from dukw_common.sources import SourceWatch
 
 
 class Holder(IntEnum):
@@ -83,6 +87,7 @@ class CommandGate:
                                      'waiting for the servo controller')
         self._commands = {a: NEUTRAL for a in self.ACTUATORS}
         self._stamps = {a: -math.inf for a in self.ACTUATORS}
+        self.sources = SourceWatch()
         self.changed = True
 
     @property
@@ -122,11 +127,16 @@ class CommandGate:
         self._set(reason=Reason.SHUTDOWN, outputs_neutral=True, detail='shutting down')
         self._drop_commands()
 
+    def set_publishers(self, actuator: str, count: int, names: tuple[str, ...] = ()) -> None:
+        """How many nodes publish ``<actuator>/cmd``: more than one neutralises both."""
+        if self.sources.update(f'{actuator}/cmd', count, names) and count > 1:
+            self._drop_commands()
+
     def command(self, actuator: str, cmd: SideCommand, now_s: float) -> bool:
         """Store a computer command; return False (ignored) unless the computer holds authority."""
         if actuator not in self._commands:
             raise ValueError(f'unknown actuator {actuator!r}; known: {self.ACTUATORS}')
-        if self._state.holder != Holder.COMPUTER:
+        if self._state.holder != Holder.COMPUTER or self.sources.fault():
             return False
         self._commands[actuator] = cmd
         self._stamps[actuator] = now_s
@@ -134,6 +144,11 @@ class CommandGate:
 
     def outputs(self, now_s: float) -> dict[str, SideCommand]:
         """Computer-side outputs now: the fresh commands, or NEUTRAL per actuator."""
+        conflict = self.sources.fault()
+        if conflict and self._state.holder == Holder.COMPUTER:
+            self._set(outputs_neutral=True, detail=f'second command source: {conflict}; '
+                                                   'outputs neutral')
+            return {a: NEUTRAL for a in self.ACTUATORS}
         out = {}
         live = False
         for actuator in self.ACTUATORS:

@@ -59,6 +59,7 @@ class GpsVelocity:
     north_mps: float
     up_mps: float
     variance_enu: tuple[float, float, float]
+    valid: bool = True    # False: the receiver had no fix (never published; the other is used)
 
 
 @dataclass(frozen=True)

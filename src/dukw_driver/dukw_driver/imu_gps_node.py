@@ -91,7 +91,8 @@ class ImuGpsNode(Node):
                 elif isinstance(item, GpsFix) and self.fix_pref.accept(
                         item.source, now_s, usable=item.status != FixStatus.NO_FIX):
                     self.fix_pub.publish(self._fix(item, stamp))
-                elif isinstance(item, GpsVelocity) and self.vel_pref.accept(item.source, now_s):
+                elif isinstance(item, GpsVelocity) and self.vel_pref.accept(
+                        item.source, now_s, usable=item.valid) and item.valid:
                     self.vel_pub.publish(self._vel(item, stamp))
 
     def _imu(self, s: ImuSample, stamp) -> Imu:

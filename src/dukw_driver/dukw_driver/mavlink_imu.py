@@ -13,7 +13,9 @@ Messages used:
   the FLU z axis). A lower-priority source is ignored once a better one is seen.
 - ``GPS_RAW_INT``: the IMU's GPS fix (``h_acc``/``v_acc`` when reported, else
   HDOP times a UERE).
-- ``GLOBAL_POSITION_INT``: the IMU's EKF velocity (NED cm/s) -> ENU.
+- ``GLOBAL_POSITION_INT``: the IMU's EKF velocity (NED cm/s) -> ENU; valid only
+  while the latest ``GPS_RAW_INT`` reports a fix (ArduPilot keeps sending zeros
+  without one, which must not read as standing still).
 """
 from __future__ import annotations
 
@@ -143,6 +145,7 @@ class MavlinkImuDecoder:
         self._accel: tuple[float, float, float] | None = None
         self._accel_time_s = -math.inf
         self._velocity_variance = settings.velocity_std_mps ** 2
+        self._gps_has_fix = False       # until a GPS_RAW_INT reports one
 
     def feed(self, data: bytes, now_s: float) -> list[Decoded]:
         """Decode received bytes at time ``now_s``."""
@@ -284,6 +287,7 @@ class MavlinkImuDecoder:
         if msg.vel_acc > 0:
             self._velocity_variance = (msg.vel_acc / 1000.0) ** 2
         status = GPS_FIX_STATUS.get(msg.fix_type, FixStatus.NO_FIX)
+        self._gps_has_fix = status != FixStatus.NO_FIX
         if status == FixStatus.NO_FIX:
             nan = math.nan
             return GpsFix(GnssSource.MAVLINK, status, nan, nan, nan, (0.0, 0.0, 0.0),
@@ -306,4 +310,5 @@ class MavlinkImuDecoder:
     def _on_global_position_int(self, msg, _now_s: float) -> GpsVelocity:
         east, north, up = ned_to_enu(msg.vx / 100.0, msg.vy / 100.0, msg.vz / 100.0)
         variance = self._velocity_variance
-        return GpsVelocity(GnssSource.MAVLINK, east, north, up, (variance,) * 3)
+        return GpsVelocity(GnssSource.MAVLINK, east, north, up, (variance,) * 3,
+                           valid=self._gps_has_fix)

@@ -7,7 +7,10 @@
   than ``gst_max_age_s`` makes the fix's covariance DIAGONAL_KNOWN, otherwise it
   is APPROXIMATED from HDOP times a UERE.
 - VTG (preferred) or RMC (when no VTG came within ``VTG_PREFERRED_S``) gives
-  speed and course over ground -> ENU velocity.
+  speed and course over ground -> ENU velocity, only while the receiver says it
+  is valid: a VTG or RMC mode indicator N (not valid) or E (dead reckoning), an
+  RMC status V, or a VTG within ``VTG_PREFERRED_S`` of an RMC with status V gives
+  no velocity (a receiver without a fix sends "0.0": not a standing still).
 """
 from __future__ import annotations
 
@@ -21,6 +24,9 @@ from dukw_driver.nmea_stream import NmeaStream
 KNOT_MPS = 1852.0 / 3600.0
 #: An RMC velocity is dropped while VTG sentences keep coming within this time.
 VTG_PREFERRED_S = 2.0
+
+#: NMEA 2.3 mode indicators (VTG, RMC) that mean the speed is not a measurement.
+INVALID_MODES = ('N', 'E')
 
 GGA_STATUS = {1: FixStatus.FIX, 2: FixStatus.GBAS_FIX, 3: FixStatus.GBAS_FIX,
               4: FixStatus.GBAS_FIX, 5: FixStatus.GBAS_FIX, 9: FixStatus.SBAS_FIX}
@@ -46,6 +52,7 @@ class GpsNmeaDecoder:
         self.counters = self.stream.counters
         self._gst: tuple[float, float, float, float] | None = None  # lat, lon, alt std, time
         self._last_vtg_s = -math.inf
+        self._rmc_void_s = -math.inf    # when an RMC last said status V
 
     def reset(self) -> None:
         """Forget partial input and the last GST (after a reconnect)."""
@@ -91,17 +98,24 @@ class GpsNmeaDecoder:
         self._gst = (*(float(s) for s in stds), now_s)
 
     def _on_vtg(self, vtg, now_s: float) -> GpsVelocity | None:
+        self._last_vtg_s = now_s
+        if getattr(vtg, 'faa_mode', '') in INVALID_MODES or \
+                now_s - self._rmc_void_s < VTG_PREFERRED_S:
+            return None
         if vtg.spd_over_grnd_kmph is not None:
             speed = float(vtg.spd_over_grnd_kmph) / 3.6
         elif vtg.spd_over_grnd_kts is not None:
             speed = float(vtg.spd_over_grnd_kts) * KNOT_MPS
         else:
             return None
-        self._last_vtg_s = now_s
         return self._velocity(speed, vtg.true_track)
 
     def _on_rmc(self, rmc, now_s: float) -> GpsVelocity | None:
-        if rmc.status != 'A' or now_s - self._last_vtg_s < VTG_PREFERRED_S:
+        if rmc.status != 'A' or getattr(rmc, 'mode_indicator', '') in INVALID_MODES:
+            self._rmc_void_s = now_s
+            return None
+        self._rmc_void_s = -math.inf
+        if now_s - self._last_vtg_s < VTG_PREFERRED_S:
             return None
         if rmc.spd_over_grnd is None:
             return None

@@ -14,7 +14,8 @@ from std_msgs.msg import Header
 
 from dukw_common.diagnostics import Level
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
-                                    declare_parameters, diagnostic_array, run_node)
+                                    declare_parameters, diagnostic_array, publisher_sources,
+                                    run_node)
 from dukw_driver.maestro import ServoSwitch, switch_config
 from dukw_driver.serial_link import DeviceHealth, SerialLink
 
@@ -75,6 +76,7 @@ class ServoSwitchNode(Node):
 
     def on_command(self, actuator: str, msg: DiffCommand) -> None:
         """Offer a computer command to the gate; refuse NaN / out-of-range with a warning."""
+        self.switch.gate.set_publishers(actuator, *publisher_sources(self, f'{actuator}/cmd'))
         try:
             self.switch.command(actuator, msg.port_pct, msg.stbd_pct, time.monotonic())
         except ValueError as exc:
@@ -122,6 +124,8 @@ class ServoSwitchNode(Node):
                              reason=state.reason.name, device_errors=','.join(device_errors))
         if device_errors:
             health.worsen(Level.WARN, 'Maestro errors: ' + ', '.join(device_errors))
+        if self.switch.gate.sources.fault():
+            health.worsen(Level.ERROR, state.detail)
         self.diag_pub.publish(diagnostic_array(self, [health]))
 
     def on_shutdown(self) -> None:

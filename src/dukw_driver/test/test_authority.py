@@ -31,6 +31,21 @@ def test_computer_commands_pass_while_fresh_then_time_out_to_neutral():
     assert gate.state.outputs_neutral
 
 
+def test_a_second_command_publisher_neutralises_until_it_is_gone():
+    gate = computer_gate()
+    gate.set_publishers('tracks', 1)
+    assert gate.command('tracks', SideCommand(60, 56), now_s=1.0)
+    gate.set_publishers('tracks', 2, ('/drive_controller_node', '/stranger'))
+    assert not gate.command('tracks', SideCommand(100, -100), now_s=1.05)
+    assert gate.outputs(1.1) == {'tracks': NEUTRAL, 'props': NEUTRAL}
+    assert gate.state.outputs_neutral and '/stranger' in gate.state.detail
+    gate.set_publishers('tracks', 1)
+    assert gate.outputs(1.15)['tracks'] == NEUTRAL        # the old command is forgotten
+    assert gate.command('tracks', SideCommand(60, 56), now_s=1.2)
+    assert gate.outputs(1.2)['tracks'] == SideCommand(60, 56)
+    assert not gate.state.outputs_neutral
+
+
 def test_rc_takeover_blocks_and_forgets_computer_commands():
     gate = computer_gate()
     gate.command('tracks', SideCommand(80, 80), now_s=0.0)

@@ -21,15 +21,17 @@ pytestmark = pytest.mark.ros
 class FakeImu:
     """A GPS-aided IMU streaming MAVLink 2: heading north, turning to port, at rest on z."""
 
-    def __init__(self):
+    def __init__(self, fix_type=3, north_cmps=150):
         self.encoder = mavlink.MAVLink(None, srcSystem=1, srcComponent=1)
+        self.fix_type, self.north_cmps = fix_type, north_cmps
 
     def stream(self):
         msgs = [mavlink.MAVLink_scaled_imu_message(1, 0, 0, -1000, 0, 0, -200, 0, 0, 0),
                 mavlink.MAVLink_attitude_message(1, 0.0, 0.0, 0.0, 0.0, 0.0, -0.2),
-                mavlink.MAVLink_gps_raw_int_message(1, 3, 361836000, -757510000, 5000, 120,
-                                                    200, 0, 0, 10),
-                mavlink.MAVLink_global_position_int_message(1, 0, 0, 0, 0, 150, 0, 0, 0)]
+                mavlink.MAVLink_gps_raw_int_message(1, self.fix_type, 361836000, -757510000,
+                                                    5000, 120, 200, 0, 0, 10),
+                mavlink.MAVLink_global_position_int_message(1, 0, 0, 0, 0, self.north_cmps,
+                                                            0, 0, 0)]
         return b''.join(m.pack(self.encoder) for m in msgs)
 
 
@@ -89,6 +91,22 @@ def test_publishes_imu_fix_and_velocity_in_ros_frames(graph):
     assert (vel.twist.twist.linear.x, vel.twist.twist.linear.y) == pytest.approx((0.0, 1.5))
     assert graph.spin_until(lambda: graph.status('mavlink') and graph.status('nmea'))
     assert graph.status('mavlink').level == b'\x00', graph.status('mavlink').message
+
+
+def test_imu_without_gps_fix_gives_no_velocity_and_the_dgps_takes_over(tmp_path):
+    no_fix = FakeImu(fix_type=1, north_cmps=0)           # ArduPilot without a fix: zeros
+    with FakeDevice(tmp_path / 'ttyImu', stream=no_fix.stream, stream_period_s=0.02) as imu, \
+            FakeDevice(tmp_path / 'ttyDgps', stream=dgps_stream, stream_period_s=0.1) as dgps, \
+            ros_node('probe_no_fix') as (probe, executor):
+        graph = Graph(probe, executor, **{'mavlink.port': str(imu.path),
+                                          'nmea.port': str(dgps.path)})
+        try:
+            assert graph.spin_until(lambda: graph.vel, 20.0)
+            graph.spin_until(lambda: False, 0.5)              # let the IMU stream on
+            ys = {round(v.twist.twist.linear.y, 3) for v in graph.vel}
+            assert ys == {1.5}, ys                        # only the DGPS's 5.4 km/h north
+        finally:
+            graph.close()
 
 
 def test_unplugged_imu_is_an_error_and_publishes_again_after_replug(graph, devices):

@@ -143,6 +143,16 @@ def test_global_position_velocity_ned_to_enu():
     assert vel.variance_enu == pytest.approx((0.01, 0.01, 0.01))
 
 
+def test_global_position_velocity_is_valid_only_with_a_gps_fix():
+    dec = MavlinkImuDecoder(SETTINGS)
+    vel_msg = mavlink.MAVLink_global_position_int_message(1, 0, 0, 0, 0, 0, 0, 0, 0)
+    assert not dec.feed(pack(vel_msg), 0.0)[0].valid            # no GPS_RAW_INT yet
+    for fix_type, valid in ((1, False), (3, True), (0, False)):
+        raw = mavlink.MAVLink_gps_raw_int_message(1, fix_type, 0, 0, 0, 65535, 65535, 0, 0, 0)
+        dec.feed(pack(raw), 0.0)
+        assert dec.feed(pack(vel_msg), 0.0)[0].valid is valid
+
+
 def test_nan_attitude_and_bad_quaternion_are_parse_errors():
     dec = MavlinkImuDecoder(SETTINGS)
     assert dec.feed(attitude(roll=math.nan), 0.0) == []

@@ -84,6 +84,19 @@ def test_rmc_gives_velocity_only_when_no_vtg_comes():
     assert dec.feed(void, 10.0) == []
 
 
+def test_no_velocity_while_the_receiver_says_it_is_not_valid():
+    dec = GpsNmeaDecoder(SETTINGS)
+    assert dec.feed(nmea_sentence('GPVTG,,T,,M,0.000,N,0.000,K,N'), 0.0) == []   # no fix
+    assert dec.feed(nmea_sentence('GPVTG,090.0,T,,M,1.0,N,1.852,K,E'), 0.1) == []  # dead reck.
+    void = nmea_sentence('GPRMC,120000.00,V,3642.000,N,12148.000,W,0.0,,221126,,,A')
+    assert dec.feed(void, 1.0) == []
+    assert dec.feed(nmea_sentence('GPVTG,,T,,M,0.0,N,0.0,K,A'), 1.1) == []  # RMC said void
+    rmc = nmea_sentence('GPRMC,120000.00,A,3642.000,N,12148.000,W,0.0,,221126,,,D')
+    dec.feed(rmc, 2.0)
+    (vel,) = dec.feed(nmea_sentence('GPVTG,,T,,M,0.0,N,0.0,K,D'), 2.1)    # fix back
+    assert (vel.east_mps, vel.north_mps) == (0.0, 0.0)
+
+
 def test_standing_still_without_course_is_zero_velocity():
     (vel,) = GpsNmeaDecoder(SETTINGS).feed(nmea_sentence('GPVTG,,T,,M,0.0,N,0.0,K,A'), 0.0)
     assert (vel.east_mps, vel.north_mps) == (0.0, 0.0)

@@ -94,6 +94,11 @@ class EkfNode(Node):
         self.diag_pub.publish(diagnostic_array(self, self.estimator.health(self._now_s())))
 
     def _on_set_pose(self, request, response):
+        if self.count_clients('set_pose') > 1:     # one client (the operator's) or none
+            response.success = False
+            response.message = f"refused: set_pose has {self.count_clients('set_pose')} clients"
+            self.get_logger().error(response.message)
+            return response
         response.success = self.estimator.set_pose(request.x_m, request.y_m, request.yaw_rad)
         response.message = 'pose set' if response.success else 'refused: non-finite pose'
         return response

@@ -10,7 +10,9 @@ from dukw_msgs.srv import SetOperator
 from rclpy.node import Node
 
 from dukw_common.config import ConfigError
-from dukw_common.node_tools import COMMAND_QOS, declare_parameters, diagnostic_array, run_node
+from dukw_common.diagnostics import Level
+from dukw_common.node_tools import (COMMAND_QOS, declare_parameters, diagnostic_array,
+                                    publisher_sources, run_node)
 from dukw_driver.authority import CommandGate
 from dukw_sim.core import Actuation, SimCore
 from dukw_sim.runtime import Pacer, SpeedMeter, sim_healths
@@ -57,6 +59,7 @@ class SimNode(Node):
 
     def on_command(self, actuator: str, msg: DiffCommand) -> None:
         """A computer command, through the servo switch's rule (rejected if malformed)."""
+        self.switch.gate.set_publishers(actuator, *publisher_sources(self, f'{actuator}/cmd'))
         try:
             self.switch.command(actuator, msg.port_pct, msg.stbd_pct, self.truth.t_s)
         except ValueError as exc:
@@ -110,11 +113,16 @@ class SimNode(Node):
         """Simulator speed, authority, and every topic's rate (Hz of sim time)."""
         t = self.truth.t_s
         rates = self.meter.report(time.monotonic(), t, self.counts)
-        array = diagnostic_array(self, sim_healths(
+        healths = sim_healths(
             t, self.pacer.rtf, self.meter, self.pacer.dropped_s,
             {'steps': self.pacer.steps, 'start_at': self.params['start_at'],
              'medium': self.truth.medium.name}, self.switch.state, self.switch.rejected,
-            self.switch.ignored, rates))
+            self.switch.ignored, rates)
+        if self.switch.gate.sources.fault():       # a second tracks/props commander
+            for health in healths:
+                if health.name == 'authority':
+                    health.worsen(Level.ERROR, self.switch.state.detail)
+        array = diagnostic_array(self, healths)
         set_stamp(array.header, t)
         return array
 

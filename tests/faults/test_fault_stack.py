@@ -1,0 +1,57 @@
+"""Fault matrix, the whole simulated stack (README "Failsafes").
+
+Row: the EKF process dies. Injected: SIGKILL to ekf_node while `bringup sim` drives the
+mission. Must: the controller's tracks/cmd neutral within 0.5 s (pitch and traction
+stale) and the runner stops the stack with exit 1 naming the node.
+"""
+import re
+import signal
+import subprocess
+import time
+
+import pytest
+from dukw_msgs.msg import DiffCommand
+
+from dukw_common.node_tools import COMMAND_QOS
+from dukw_common.testing import executable, ros_node, spin_until
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+
+TIMEOUT_S = 0.5                  # imu_timeout_s / traction_timeout_s (config)
+SLACK_S = 0.15
+
+
+def test_killed_ekf_ends_in_neutral_and_stops_the_stack():
+    runner = subprocess.Popen([str(executable('dukw_bringup', 'bringup')), 'sim', '--quiet'],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        pids = {}
+        deadline = time.monotonic() + 60.0
+        while len(pids) < 5 and time.monotonic() < deadline:
+            match = re.search(r'started (\w+) \(pid (\d+)\)', runner.stdout.readline())
+            if match:
+                pids[match.group(1)] = int(match.group(2))
+        tracks = []
+        with ros_node('stack_probe') as (node, executor):
+            node.create_subscription(DiffCommand, 'tracks/cmd',
+                                     lambda m: tracks.append((time.monotonic(), m)),
+                                     COMMAND_QOS)
+            assert spin_until(executor, lambda: tracks and abs(tracks[-1][1].stbd_pct) > 5.0,
+                              90.0), 'the mission never drove'
+            since = time.monotonic()
+            subprocess.run(['kill', '-KILL', str(pids['ekf_node'])], check=True)
+
+            def neutral_after():
+                return [t for t, m in tracks if t > since and m.port_pct == 0.0
+                        and m.stbd_pct == 0.0]
+            assert spin_until(executor, neutral_after, 10.0)
+            reaction = neutral_after()[0] - since
+        print(f'EKF killed -> neutral tracks: {reaction:.3f} s')
+        assert reaction <= TIMEOUT_S + SLACK_S
+        out, err = runner.communicate(timeout=60)
+    finally:
+        if runner.poll() is None:
+            runner.send_signal(signal.SIGINT)
+            runner.communicate(timeout=60)
+    assert runner.returncode == 1
+    assert 'ekf_node exited unexpectedly (killed by signal 9)' in out + err
