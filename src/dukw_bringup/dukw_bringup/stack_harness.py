@@ -1,4 +1,9 @@
-"""The control cores closed around the simulator core.
+"""The in-process stack: the control cores closed around the simulator core.
+
+Used by the closed-loop tests (dukw_control/test/closed_loop.py re-exports it) and by
+campaigns (dukw_bringup.campaign). Between the drive controller and the simulator sits
+the servo switch's rule (dukw_driver.authority.CommandGate): the computer's commands
+reach the motors only while it holds authority and they are fresh.
 
 The controller sees what its node would see: surge speed and yaw rate (odometry),
 pitch (IMU), track currents and slips; the mode manager sees water contact, a
@@ -20,6 +25,7 @@ from dukw_common.geometry import euler_from_quaternion
 from dukw_control import controller, modes
 from dukw_control.controller import ControllerSettings, DriveController
 from dukw_control.modes import ModeManager, ModeSettings
+from dukw_driver.authority import CommandGate, SideCommand
 from dukw_sim.core import Actuation, SimCore
 from dukw_sim.truth import Truth
 
@@ -50,7 +56,12 @@ class ClosedLoop:
     def __init__(self, sim_overrides=None, seed: int = 0, start: str = 'sand',
                  x_m: float | None = None, yaw_rad: float = 0.0,
                  controller_settings: ControllerSettings | None = None,
-                 mode_settings: ModeSettings | None = None, feedback: str = 'truth') -> None:
+                 mode_settings: ModeSettings | None = None, feedback: str = 'truth',
+                 estimator_knows_site: bool = True, sensor_filter=None) -> None:
+        """``estimator_knows_site=False``: the estimator keeps the configured vehicle, beach
+        and soil while ``sim_overrides`` change the simulated ones (model mismatch).
+        ``sensor_filter(readings) -> readings``: faults injected between sensors and
+        the stack (dropouts, outliers); ekf feedback only."""
         if feedback not in ('truth', 'ekf'):
             raise ValueError(f"feedback must be 'truth' or 'ekf', got {feedback!r}")
         self.sim = SimCore.from_config(overrides=sim_overrides or {}, seed=seed)
@@ -61,9 +72,17 @@ class ClosedLoop:
             from dukw_sim.sensors import SensorModel
             self.sensors = SensorModel.from_config(seed=seed)
             gps = self.sensors.config.gps
-            self.est = build_estimator(self.sim.vehicle, (gps.datum_lat_deg, gps.datum_lon_deg,
-                                                          gps.datum_alt_m))
+            vehicle = self.sim.vehicle
+            if not estimator_knows_site:
+                from dukw_common.vehicle import Vehicle
+                vehicle = Vehicle.from_params(node_params('ekf_node'))
+            self.est = build_estimator(vehicle, (gps.datum_lat_deg, gps.datum_lon_deg,
+                                                 gps.datum_alt_m))
             self.adapter = SensorAdapter(self.est)
+        self.sensor_filter = sensor_filter
+        self.estimate = None
+        self.gate = CommandGate(node_params('sim_node')['command_timeout_s'])
+        self.gate.update_rc(rc_selected=False, rc_link_ok=True)
         self.ctrl = DriveController(controller_settings or default_controller_settings())
         self.modes = ModeManager(mode_settings or default_mode_settings())
         self.gain = self.sim.vehicle.drivetrain.track_force_gain_n_per_a
@@ -75,6 +94,7 @@ class ClosedLoop:
 
     def set_authority(self, usable: bool) -> None:
         """The operator takes over (False) or gives the vehicle back (True)."""
+        self.gate.update_rc(rc_selected=not usable, rc_link_ok=True)
         self.ctrl.on_authority(usable, 'computer' if usable else 'RC operator',
                                self.truth.t_s)
 
@@ -95,13 +115,21 @@ class ClosedLoop:
                 self.record.modes.append((t, decision.mode, decision.reason))
         out = c.step(t)
         self.k += 1
-        self.truth = self.sim.step(Actuation(out.tracks.port, out.tracks.stbd,
-                                             out.props.port, out.props.stbd))
+        self.truth = self.sim.step(self._switch(out, t))
         rec = self.record
         rec.truth.append(self.truth)
         rec.tracks.append((out.tracks.port, out.tracks.stbd))
         rec.props.append((out.props.port, out.props.stbd))
         return self.truth
+
+    def _switch(self, out, t: float) -> Actuation:
+        """The servo switch: computer commands pass only while it holds authority, fresh.
+        (The operator's sticks are neutral here: RC authority gives neutral outputs.)"""
+        self.gate.command('tracks', SideCommand(out.tracks.port, out.tracks.stbd), t)
+        self.gate.command('props', SideCommand(out.props.port, out.props.stbd), t)
+        sent = self.gate.outputs(t)
+        tracks, props = sent['tracks'], sent['props']
+        return Actuation(tracks.port_pct, tracks.stbd_pct, props.port_pct, props.stbd_pct)
 
     def _feed_truth(self, t: float) -> None:
         tr, c, m = self.truth, self.ctrl, self.modes
@@ -117,7 +145,10 @@ class ClosedLoop:
 
     def _feed_sensors(self, t: float) -> None:
         c, m = self.ctrl, self.modes
-        for reading in self.sensors.sample(self.truth):
+        readings = self.sensors.sample(self.truth)
+        if self.sensor_filter is not None:
+            readings = self.sensor_filter(readings)
+        for reading in readings:
             self.adapter.feed(reading)
             kind = type(reading).__name__
             if kind == 'ImuReading':
@@ -133,6 +164,7 @@ class ClosedLoop:
             return
         self.est.advance(t)
         odo, trc = self.est.odometry(), self.est.traction()
+        self.estimate = (t, odo, trc)        # what the stack saw at t (campaign metrics)
         c.on_odometry(odo.surge_mps, odo.yaw_rate_rps, t)
         c.on_slips(trc.port_slip, trc.stbd_slip, t)
         m.on_traction(trc.weight_on_tracks_fraction, t)
