@@ -226,7 +226,7 @@ def draw_conditions(spec: Spec, index: int) -> dict:
         f = spec.faults[name]
         active = bool(rng.random() < f['probability'])
         drawn = [_draw(rng, f[field]) for field in fields]
-        for field, value in zip(fields, drawn):
+        for field, value in zip(fields, drawn, strict=True):
             out[f'{name}_{field}'] = value if active else 0.0
         out[name] = active
     for key in sorted(spec.sim_overrides):
@@ -405,7 +405,7 @@ def _mode_delays(t: np.ndarray, medium: np.ndarray, mode_log: list) -> tuple[flo
 def _chatter(medium: np.ndarray, mode_log: list) -> int:
     """Mode changes beyond the fewest that lead from the start medium to the end one."""
     modes = [int(m) for _, m, _ in mode_log]
-    changes = sum(1 for a, b in zip(modes, modes[1:]) if a != b)
+    changes = sum(1 for a, b in zip(modes, modes[1:], strict=False) if a != b)
     expected = abs(int(medium[-1]) - int(medium[0])) if medium.size else 0
     return max(0, changes - expected)
 

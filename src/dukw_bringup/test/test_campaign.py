@@ -1,0 +1,154 @@
+"""campaign (issue 18): randomized stack runs on a Dask LocalCluster of 2 worker processes.
+
+Short runs (6 s) keep it fast; one run in three draws an invalid simulator time step, so
+the campaign has runs that raise and must still finish.
+"""
+import csv
+import json
+import math
+
+import pytest
+import yaml
+
+from dukw_bringup import campaign, campaign_cli
+
+pytestmark = pytest.mark.timeout(300)
+
+SPEC = {
+    'name': 'test', 'seed': 7, 'runs': 6, 'duration_s': 6.0, 'warm_up_s': 2.0,
+    'kinds': ['land_to_sea', 'sea_to_land'],
+    'draws': {'significant_wave_height_m': {'uniform': [0.0, 0.35]},
+              'peak_period_s': {'uniform': [3.0, 6.0]},
+              'spreading_rad': {'uniform': [0.0, 0.6]},
+              'beach_slope_deg': {'uniform': [3.0, 6.0]},
+              'soil_preset': {'choice': ['', 'beach_64', 'beach_80']},
+              'cohesion_kpa': {'uniform': [0.11, 0.18]},
+              'friction_angle_deg': {'uniform': [5.58, 15.0]},
+              'shear_modulus_cm': {'uniform': [0.0, 18.0]},
+              'speed_mps': {'uniform': [0.6, 1.0]},
+              'start_offset_m': {'uniform': [-1.0, 1.0]},
+              'sim_seed': {'integers': [0, 1000]}, 'sensor_seed': {'integers': [0, 1000]}},
+    'faults': {'gps_dropout': {'probability': 0.5, 'start_s': {'uniform': [2.0, 4.0]},
+                               'duration_s': 1.0},
+               'gps_outlier': {'probability': 0.5, 'start_s': 3.0, 'offset_m': 10.0}},
+    'targets': {'slip_rmse': 0.05, 'volume_error_pct': 10.0, 'fraction_error': 0.1,
+                'mode_delay_s': 1.0},
+    # a run drawing dt = -1 s raises in SimCore (ConfigError): recorded, not fatal
+    'sim_overrides': {'physics.dt_s': {'choice': [0.01, 0.01, -1.0]}},
+}
+NOT_COMPARED = {'wall_s'}
+
+
+def _write_spec(path, spec):
+    path.write_text(yaml.safe_dump(spec), encoding='utf-8')
+    return str(path)
+
+
+def _rows(out):
+    with open(out / 'runs.csv', encoding='utf-8') as f:
+        return list(csv.DictReader(f))
+
+
+@pytest.fixture(scope='module')
+def twice(tmp_path_factory):
+    """The same 6-run campaign twice, each on its own LocalCluster of 2 processes."""
+    base = tmp_path_factory.mktemp('campaign')
+    spec = _write_spec(base / 'spec.yaml', SPEC)
+    outs = []
+    for k in range(2):
+        out = base / f'out{k}'
+        code = campaign_cli.main([spec, '--workers', '2', '--out', str(out), '--no-progress'])
+        assert code == 0
+        outs.append(out)
+    return spec, outs
+
+
+def test_campaign_writes_one_row_per_run_summary_and_plots(twice):
+    _, (out, _) = twice
+    for name in ('runs.csv', 'summary.json', 'histograms.png', 'metrics_vs_conditions.png'):
+        assert (out / name).stat().st_size > 0, name
+    rows = _rows(out)
+    assert [int(r['index']) for r in rows] == list(range(6))
+    done = [r for r in rows if not r['error']]
+    assert done, 'every run raised'
+    for r in done:
+        assert 0.0 <= float(r['slip_rmse']) < 1.0
+        assert 0.0 < float(r['peak_current_a']) < 100.0
+        assert float(r['significant_wave_height_m']) <= 0.35
+    summary = json.loads((out / 'summary.json').read_text())
+    assert summary['runs'] == 6 and summary['completed'] == len(done)
+    met = sum(r['targets_met'] == 'True' for r in done)
+    assert summary['share_meeting_targets'] == pytest.approx(met / 6, abs=1e-4)
+    missed = {int(r['index']) for r in done if r['targets_met'] == 'False'}
+    assert {r['index'] for r in summary['out_of_target_runs']} == missed
+
+
+def test_a_run_that_raises_is_recorded_with_its_traceback(twice):
+    _, (out, _) = twice
+    rows = _rows(out)
+    raised = [r for r in rows if r['error']]
+    assert raised and len(raised) < 6
+    for r in raised:
+        assert float(r['sim.physics.dt_s']) == -1.0
+        assert 'Traceback' in r['error'] and 'dt_s' in r['error']
+    summary = json.loads((out / 'summary.json').read_text())
+    assert summary['failed_indices'] == sorted(int(r['index']) for r in raised)
+
+
+def test_the_same_campaign_gives_identical_metrics(twice):
+    _, (first, second) = twice
+    a, b = _rows(first), _rows(second)
+    assert len(a) == len(b) == 6
+    for ra, rb in zip(a, b, strict=True):
+        assert {k: v for k, v in ra.items() if k not in NOT_COMPARED} == {
+            k: v for k, v in rb.items() if k not in NOT_COMPARED}
+
+
+def test_rerun_reproduces_a_runs_metrics_exactly(twice, tmp_path):
+    spec, (out, _) = twice
+    row = next(r for r in _rows(out) if not r['error'])
+    assert campaign_cli.main([spec, '--rerun', row['index'], '--out', str(tmp_path)]) == 0
+    again = json.loads((tmp_path / 'run.json').read_text())
+    for key, value in row.items():
+        if key in NOT_COMPARED or key == 'error':
+            continue
+        got = again[key]
+        if isinstance(got, float) and math.isnan(got):
+            assert value == 'nan', key
+        else:
+            assert str(got) == value, key
+    series = (tmp_path / 'series.csv').read_text().splitlines()
+    assert series[0].startswith('t_s,x_m') and len(series) > 300
+    assert (tmp_path / 'series.png').stat().st_size > 0
+
+
+def test_draws_depend_only_on_seed_and_index():
+    spec = campaign.parse_spec(SPEC)
+    assert campaign.draw_conditions(spec, 3) == campaign.draw_conditions(spec, 3)
+    assert campaign.draw_conditions(spec, 3) != campaign.draw_conditions(spec, 4)
+    other = campaign.parse_spec(dict(SPEC, seed=8))
+    assert campaign.draw_conditions(other, 3) != campaign.draw_conditions(spec, 3)
+
+
+@pytest.mark.parametrize('change, message', [
+    ({'kinds': ['circle']}, 'kinds must be'),
+    ({'runs': 0}, 'runs must be'),
+    ({'draws': dict(SPEC['draws'], beach_slope_deg={'uniform': [6.0, 3.0]})},
+     'draws.beach_slope_deg.uniform'),
+    ({'draws': dict(SPEC['draws'], significant_wave_height_m={'normal': [0, 1]})},
+     'draws.significant_wave_height_m must be'),
+    ({'draws': dict(SPEC['draws'], soil_preset='moon_dust')}, "unknown preset 'moon_dust'"),
+    ({'draws': {k: v for k, v in SPEC['draws'].items() if k != 'speed_mps'}},
+     'draws.speed_mps is missing'),
+    ({'faults': {'imu_melt': {}}}, 'unknown field'),
+    ({'targets': {'slip_rmse': 0.05}}, 'targets.volume_error_pct'),
+    ({'colour': 'red'}, "unknown field(s) ['colour']"),
+])
+def test_spec_errors_are_refused_with_the_field_named(change, message, tmp_path, capsys):
+    with pytest.raises(campaign.SpecError) as err:
+        campaign.parse_spec(dict(SPEC, **change))
+    assert message in str(err.value)
+    path = _write_spec(tmp_path / 'bad.yaml', dict(SPEC, **change))
+    assert campaign_cli.main([path, '--out', str(tmp_path / 'out')]) == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / 'out').exists()
