@@ -23,20 +23,24 @@ import yaml
 
 from dukw_common.config import node_params
 
-KINDS = ('land_to_sea', 'sea_to_land')
+KINDS = ('land_to_sea', 'sea_to_land', 'land_circle', 'water_circle')
 #: Drawn per run, in this order (the order is part of reproducibility: never reorder).
 DRAWS = ('kind', 'significant_wave_height_m', 'peak_period_s', 'spreading_rad',
          'beach_slope_deg', 'soil_preset', 'cohesion_kpa', 'friction_angle_deg',
-         'shear_modulus_cm', 'speed_mps', 'start_offset_m', 'sim_seed', 'sensor_seed')
+         'shear_modulus_cm', 'speed_mps', 'start_offset_m', 'sim_seed', 'sensor_seed',
+         'yaw_rate_rps')
+#: Draws a spec may leave out, and their constant value then.
+OPTIONAL_DRAWS = {'yaw_rate_rps': 0.0}
 #: Physical bounds a spec's distribution must stay inside (a typo is refused, not run).
 BOUNDS = {'significant_wave_height_m': (0.0, 1.0), 'peak_period_s': (1.0, 20.0),
           'spreading_rad': (0.0, math.pi), 'beach_slope_deg': (0.5, 30.0),
           'cohesion_kpa': (0.0, 5.0), 'friction_angle_deg': (0.0, 60.0),
           'shear_modulus_cm': (0.0, 100.0), 'speed_mps': (0.05, 2.0),
           'start_offset_m': (-10.0, 10.0), 'sim_seed': (0, 2 ** 32 - 1),
-          'sensor_seed': (0, 2 ** 32 - 1)}
+          'sensor_seed': (0, 2 ** 32 - 1), 'yaw_rate_rps': (-1.5, 1.5)}
 FAULTS = {'gps_dropout': ('start_s', 'duration_s'), 'gps_outlier': ('start_s', 'offset_m')}
 TARGET_NAMES = ('slip_rmse', 'volume_error_pct', 'fraction_error', 'mode_delay_s')
+LAND_CLEARANCE_M = 20.0        # the land circle runs this far landward of the slope
 SEA_TO_LAND_CLEARANCE_M = 0.30  # vehicle.md 6: floating with the treads 30 cm above the sand
 EARTH_RADIUS_M = 6_371_000.0
 MOVING_TRACK_MPS = 0.1          # slip is scored only where the track turns (as evaluate)
@@ -94,9 +98,10 @@ def parse_spec(raw: Any) -> Spec:
     _no_unknown(draws, set(DRAWS) - {'kind'}, 'draws')
     checked = {}
     for name in DRAWS[1:]:
-        if name not in draws:
+        if name not in draws and name not in OPTIONAL_DRAWS:
             raise SpecError(f'draws.{name} is missing')
-        checked[name] = _distribution(draws[name], f'draws.{name}', BOUNDS.get(name))
+        checked[name] = _distribution(draws.get(name, OPTIONAL_DRAWS.get(name)),
+                                      f'draws.{name}', BOUNDS.get(name))
     _check_presets(checked['soil_preset'])
     faults = _faults(raw.get('faults', {}))
     targets = _section(raw, 'targets')
@@ -294,8 +299,14 @@ def build_loop(spec: Spec, cond: Mapping[str, Any]):
                       estimator_knows_site=False, sensor_filter=SensorFaults(cond))
     loop.sensors.seed = cond['sensor_seed']
     loop.sensors.reset()
+    start = loop.sim.params.start
     if cond['kind'] == 'land_to_sea':
-        x_m, yaw = loop.sim.params.start.sand_x_m + cond['start_offset_m'], 0.0
+        x_m, yaw = start.sand_x_m + cond['start_offset_m'], 0.0
+    elif cond['kind'] == 'land_circle':
+        x_m = loop.sim.params.world.flat_start_x_m - LAND_CLEARANCE_M + cond['start_offset_m']
+        yaw = 0.0
+    elif cond['kind'] == 'water_circle':
+        x_m, yaw = start.afloat_x_m + cond['start_offset_m'], 0.0
     else:
         depth = loop.sim.vehicle.body.draft_m + SEA_TO_LAND_CLEARANCE_M
         x_m = depth / math.tan(math.radians(cond['beach_slope_deg'])) + cond['start_offset_m']
@@ -307,7 +318,7 @@ def build_loop(spec: Spec, cond: Mapping[str, Any]):
 def simulate(spec: Spec, cond: Mapping[str, Any]) -> tuple[np.ndarray, list, Any]:
     """Run the stack; the per-step series (SERIES_COLUMNS) and the mode changes."""
     loop = build_loop(spec, cond)
-    cmd = (cond['speed_mps'], 0.0)
+    cmd = (cond['speed_mps'], cond['yaw_rate_rps'])
     rows = []
     for _ in range(int(round(spec.duration_s / loop.sim.dt_s))):
         before = loop.truth
