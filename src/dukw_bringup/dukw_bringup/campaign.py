@@ -7,6 +7,8 @@ any run can be reproduced from (campaign seed, run index).
 
 Model mismatch: the simulator's beach slope, soil and sea are the drawn ones, while the
 estimator keeps the configured vehicle, beach and soil (``estimator_knows_site=False``).
+A spec's ``oracle_site: true`` is the diagnostic counterpart: the estimator is handed the
+drawn slope and soil, so what is left of the misses is not due to the mismatch.
 """
 from __future__ import annotations
 
@@ -66,6 +68,7 @@ class Spec:
     faults: Mapping[str, Mapping[str, Any]]
     targets: Mapping[str, float]
     sim_overrides: Mapping[str, Any]
+    oracle_site: bool = False
 
 
 def load_spec(path: str) -> Spec:
@@ -85,7 +88,7 @@ def parse_spec(raw: Any) -> Spec:
     if not isinstance(raw, dict):
         raise SpecError('campaign spec must be a mapping')
     known = {'name', 'seed', 'runs', 'duration_s', 'warm_up_s', 'kinds', 'draws', 'faults',
-             'targets', 'sim_overrides'}
+             'targets', 'sim_overrides', 'oracle_site'}
     _no_unknown(raw, known, 'spec')
     seed = _int(raw, 'seed', 0, 2 ** 63 - 1)
     runs = _int(raw, 'runs', 1, 10_000_000)
@@ -113,8 +116,12 @@ def parse_spec(raw: Any) -> Spec:
         raise SpecError('sim_overrides must be a mapping of dotted sim_node parameters')
     for key, value in overrides.items():
         _distribution(value, f'sim_overrides.{key}', None)
+    oracle = raw.get('oracle_site', False)
+    if not isinstance(oracle, bool):
+        raise SpecError(f'oracle_site must be true or false, got {oracle!r}')
     return Spec(str(raw.get('name', 'campaign')), seed, runs, duration, warm_up, tuple(kinds),
-                checked, faults, {k: float(targets[k]) for k in TARGET_NAMES}, dict(overrides))
+                checked, faults, {k: float(targets[k]) for k in TARGET_NAMES}, dict(overrides),
+                oracle)
 
 
 def _no_unknown(section: Mapping, known: set, where: str) -> None:
@@ -296,7 +303,9 @@ def build_loop(spec: Spec, cond: Mapping[str, Any]):
     """The in-process stack for these conditions, placed at its start."""
     from dukw_bringup.stack_harness import ClosedLoop
     loop = ClosedLoop(sim_overrides(cond), seed=cond['sim_seed'], feedback='ekf',
-                      estimator_knows_site=False, sensor_filter=SensorFaults(cond))
+                      estimator_knows_site=spec.oracle_site, sensor_filter=SensorFaults(cond))
+    if spec.oracle_site:                 # diagnostic: the estimator knows the drawn soil too
+        loop.est.soil = loop.sim.vehicle.soil
     loop.sensors.seed = cond['sensor_seed']
     loop.sensors.reset()
     start = loop.sim.params.start

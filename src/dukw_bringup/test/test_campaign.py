@@ -152,3 +152,20 @@ def test_spec_errors_are_refused_with_the_field_named(change, message, tmp_path,
     assert campaign_cli.main([path, '--out', str(tmp_path / 'out')]) == 2
     assert message in capsys.readouterr().err
     assert not (tmp_path / 'out').exists()
+
+
+def test_campaign_on_a_given_scheduler_address(twice, tmp_path):
+    """--scheduler: the runs go to an existing cluster, which the campaign leaves running."""
+    from distributed import Client, LocalCluster
+    spec, (first, _) = twice
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=':0') as cluster:
+        out = tmp_path / 'out'
+        assert campaign_cli.main([spec, '--runs', '3', '--scheduler', cluster.scheduler_address,
+                                  '--out', str(out), '--no-progress']) == 0
+        with Client(cluster.scheduler_address) as client:
+            assert len(client.scheduler_info()['workers']) == 2
+    expected = _rows(first)[:3]
+    for ra, rb in zip(expected, _rows(out), strict=True):
+        assert {k: v for k, v in ra.items() if k not in NOT_COMPARED} == {
+            k: v for k, v in rb.items() if k not in NOT_COMPARED}
