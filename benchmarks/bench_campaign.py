@@ -44,8 +44,8 @@ def main() -> None:
               f'{rate[workers]:6.0f} runs/h (a run itself: {per_run:.2f} s wall)')
     per_core = rate[1]
     for machines, cores in ((1, 2), (10, 8), (50, 8)):
-        hours = 10_000 / (per_core * machines * cores)
-        print(f'10 000 runs on {machines} machine(s) x {cores} cores: ~{hours:.2f} h '
+        minutes = 60.0 * 10_000 / (per_core * machines * cores)
+        print(f'10 000 runs on {machines} machine(s) x {cores} cores: ~{minutes:.0f} min '
               '(one worker per core, scaling as 1 worker)')
     print(f'load average: {os.getloadavg()[0]:.2f}')
 
