@@ -169,3 +169,34 @@ def test_campaign_on_a_given_scheduler_address(twice, tmp_path):
     for ra, rb in zip(expected, _rows(out), strict=True):
         assert {k: v for k, v in ra.items() if k not in NOT_COMPARED} == {
             k: v for k, v in rb.items() if k not in NOT_COMPARED}
+
+
+def test_gps_faults_drop_fixes_in_the_window_and_throw_one_outlier():
+    from dukw_sim.sensors import GpsFix, GpsVelocity
+    cond = {'gps_dropout': True, 'gps_dropout_start_s': 1.0, 'gps_dropout_duration_s': 0.5,
+            'gps_outlier': True, 'gps_outlier_start_s': 2.0, 'gps_outlier_offset_m': 10.0}
+    faults = campaign.SensorFaults(cond)
+
+    def fix(t):
+        return GpsFix(t, 36.0, -75.0, 0.0, (0.1, 0.1, 0.2))
+
+    assert faults([fix(1.2), GpsVelocity(1.2, (1.0, 0.0, 0.0), (0.1, 0.1, 0.1))]) == []
+    assert faults([fix(1.5)]) == [fix(1.5)]
+    moved = faults([fix(2.0)])[0]
+    north_m = math.radians(moved.latitude_deg - 36.0) * campaign.EARTH_RADIUS_M
+    east_m = (math.radians(moved.longitude_deg + 75.0) * campaign.EARTH_RADIUS_M
+              * math.cos(math.radians(36.0)))
+    assert math.hypot(north_m, east_m) == pytest.approx(10.0, rel=1e-3)
+    assert faults([fix(2.1)]) == [fix(2.1)]           # one outlier only
+
+
+def test_the_estimator_keeps_its_configured_beach_while_the_simulator_draws_another():
+    spec = campaign.parse_spec(SPEC)
+    cond = dict(campaign.draw_conditions(spec, 0), beach_slope_deg=6.0, friction_angle_deg=15.0)
+    cond['sim.physics.dt_s'] = 0.01
+    loop = campaign.build_loop(spec, cond)
+    assert loop.sim.vehicle.site.beach_slope_rad == pytest.approx(math.radians(6.0))
+    assert loop.sim.vehicle.soil.friction_angle_rad == pytest.approx(math.radians(15.0))
+    configured = campaign.node_params('ekf_node')
+    assert loop.est.vehicle.site.beach_slope_rad == configured['site.beach_slope_rad']
+    assert loop.est.soil.friction_angle_rad == configured['soil.friction_angle_rad']
