@@ -16,14 +16,14 @@ from dukw_bringup import campaign, campaign_cli
 
 def measure(spec: campaign.Spec, runs: int, workers: int) -> tuple[float, float]:
     """Wall seconds for ``runs`` on ``workers`` local processes; mean per-run wall seconds."""
-    client = campaign_cli.open_client(workers, None)
+    client, cluster = campaign_cli.open_client(workers, None)
     try:
         client.wait_for_workers(workers)
         start = time.perf_counter()
         rows = campaign_cli.run_on_dask(spec, runs, client, progress=False)
         wall = time.perf_counter() - start
     finally:
-        campaign_cli.close_client(client)
+        campaign_cli.close_client(client, cluster)
     per_run = sum(r['wall_s'] for r in rows) / len(rows)
     return wall, per_run
 

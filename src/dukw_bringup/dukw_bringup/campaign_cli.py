@@ -45,20 +45,17 @@ def run_on_dask(spec: campaign.Spec, runs: int, client, progress: bool = True,
 
 
 def open_client(workers: int, scheduler: str | None):
-    """A Client on the given scheduler, or on a new LocalCluster (closed with the client)."""
+    """(Client, its own LocalCluster or None): on the given scheduler, else a new cluster."""
     from distributed import Client, LocalCluster
     if scheduler:
-        return Client(scheduler)
+        return Client(scheduler), None
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                            dashboard_address=':0')
-    client = Client(cluster)
-    client._dukw_cluster = cluster          # closed in close_client
-    return client
+    return Client(cluster), cluster
 
 
-def close_client(client) -> None:
-    """Close the client and its own LocalCluster, if it made one."""
-    cluster = getattr(client, '_dukw_cluster', None)
+def close_client(client, cluster) -> None:
+    """Close the client, and the LocalCluster if it was ours (never a given scheduler)."""
     client.close()
     if cluster is not None:
         cluster.close()
@@ -122,11 +119,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     out = args.out or Path('runs') / f'campaign-{spec.name}-{stamp}'
     start = time.perf_counter()
-    client = open_client(args.workers, args.scheduler)
+    client, cluster = open_client(args.workers, args.scheduler)
     try:
         rows = run_on_dask(spec, runs, client, progress=not args.no_progress)
     finally:
-        close_client(client)
+        close_client(client, cluster)
     summary = write_campaign(spec, rows, out)
     wall = time.perf_counter() - start
     print(f'{summary["completed"]}/{runs} runs completed, '
