@@ -31,6 +31,8 @@ setup(
             'record = dukw_bringup.record:main',
             'play = dukw_bringup.play:main',
             'replay = dukw_bringup.replay:main',
+            # randomized runs on Dask (issue 18)
+            'campaign = dukw_bringup.campaign_cli:main',
         ],
     },
 )

@@ -1,0 +1,202 @@
+"""campaign (issue 18): randomized stack runs on a Dask LocalCluster of 2 worker processes.
+
+Short runs (6 s) keep it fast; one run in three draws an invalid simulator time step, so
+the campaign has runs that raise and must still finish.
+"""
+import csv
+import json
+import math
+
+import pytest
+import yaml
+
+from dukw_bringup import campaign, campaign_cli
+
+pytestmark = pytest.mark.timeout(300)
+
+SPEC = {
+    'name': 'test', 'seed': 7, 'runs': 6, 'duration_s': 6.0, 'warm_up_s': 2.0,
+    'kinds': ['land_to_sea', 'sea_to_land'],
+    'draws': {'significant_wave_height_m': {'uniform': [0.0, 0.35]},
+              'peak_period_s': {'uniform': [3.0, 6.0]},
+              'spreading_rad': {'uniform': [0.0, 0.6]},
+              'beach_slope_deg': {'uniform': [3.0, 6.0]},
+              'soil_preset': {'choice': ['', 'beach_64', 'beach_80']},
+              'cohesion_kpa': {'uniform': [0.11, 0.18]},
+              'friction_angle_deg': {'uniform': [5.58, 15.0]},
+              'shear_modulus_cm': {'uniform': [0.0, 18.0]},
+              'speed_mps': {'uniform': [0.6, 1.0]},
+              'start_offset_m': {'uniform': [-1.0, 1.0]},
+              'sim_seed': {'integers': [0, 1000]}, 'sensor_seed': {'integers': [0, 1000]}},
+    'faults': {'gps_dropout': {'probability': 0.5, 'start_s': {'uniform': [2.0, 4.0]},
+                               'duration_s': 1.0},
+               'gps_outlier': {'probability': 0.5, 'start_s': 3.0, 'offset_m': 10.0}},
+    'targets': {'slip_rmse': 0.05, 'volume_error_pct': 10.0, 'fraction_error': 0.1,
+                'mode_delay_s': 1.0},
+    # a run drawing dt = -1 s raises in SimCore (ConfigError): recorded, not fatal
+    'sim_overrides': {'physics.dt_s': {'choice': [0.01, 0.01, -1.0]}},
+}
+NOT_COMPARED = {'wall_s'}
+
+
+def _write_spec(path, spec):
+    path.write_text(yaml.safe_dump(spec), encoding='utf-8')
+    return str(path)
+
+
+def _rows(out):
+    with open(out / 'runs.csv', encoding='utf-8') as f:
+        return list(csv.DictReader(f))
+
+
+@pytest.fixture(scope='module')
+def twice(tmp_path_factory):
+    """The same 6-run campaign twice, each on its own LocalCluster of 2 processes."""
+    base = tmp_path_factory.mktemp('campaign')
+    spec = _write_spec(base / 'spec.yaml', SPEC)
+    outs = []
+    for k in range(2):
+        out = base / f'out{k}'
+        code = campaign_cli.main([spec, '--workers', '2', '--out', str(out), '--no-progress'])
+        assert code == 0
+        outs.append(out)
+    return spec, outs
+
+
+def test_campaign_writes_one_row_per_run_summary_and_plots(twice):
+    _, (out, _) = twice
+    for name in ('runs.csv', 'summary.json', 'histograms.png', 'metrics_vs_conditions.png'):
+        assert (out / name).stat().st_size > 0, name
+    rows = _rows(out)
+    assert [int(r['index']) for r in rows] == list(range(6))
+    done = [r for r in rows if not r['error']]
+    assert done, 'every run raised'
+    for r in done:
+        assert 0.0 <= float(r['slip_rmse']) < 1.0
+        assert 0.0 < float(r['peak_current_a']) < 100.0
+        assert float(r['significant_wave_height_m']) <= 0.35
+    summary = json.loads((out / 'summary.json').read_text())
+    assert summary['runs'] == 6 and summary['completed'] == len(done)
+    met = sum(r['targets_met'] == 'True' for r in done)
+    assert summary['share_meeting_targets'] == pytest.approx(met / 6, abs=1e-4)
+    missed = {int(r['index']) for r in done if r['targets_met'] == 'False'}
+    assert {r['index'] for r in summary['out_of_target_runs']} == missed
+
+
+def test_a_run_that_raises_is_recorded_with_its_traceback(twice):
+    _, (out, _) = twice
+    rows = _rows(out)
+    raised = [r for r in rows if r['error']]
+    assert raised and len(raised) < 6
+    for r in raised:
+        assert float(r['sim.physics.dt_s']) == -1.0
+        assert 'Traceback' in r['error'] and 'dt_s' in r['error']
+    summary = json.loads((out / 'summary.json').read_text())
+    assert summary['failed_indices'] == sorted(int(r['index']) for r in raised)
+
+
+def test_the_same_campaign_gives_identical_metrics(twice):
+    _, (first, second) = twice
+    a, b = _rows(first), _rows(second)
+    assert len(a) == len(b) == 6
+    for ra, rb in zip(a, b, strict=True):
+        assert {k: v for k, v in ra.items() if k not in NOT_COMPARED} == {
+            k: v for k, v in rb.items() if k not in NOT_COMPARED}
+
+
+def test_rerun_reproduces_a_runs_metrics_exactly(twice, tmp_path):
+    spec, (out, _) = twice
+    row = next(r for r in _rows(out) if not r['error'])
+    assert campaign_cli.main([spec, '--rerun', row['index'], '--out', str(tmp_path)]) == 0
+    again = json.loads((tmp_path / 'run.json').read_text())
+    for key, value in row.items():
+        if key in NOT_COMPARED or key == 'error':
+            continue
+        got = again[key]
+        if isinstance(got, float) and math.isnan(got):
+            assert value == 'nan', key
+        else:
+            assert str(got) == value, key
+    series = (tmp_path / 'series.csv').read_text().splitlines()
+    assert series[0].startswith('t_s,x_m') and len(series) > 300
+    assert (tmp_path / 'series.png').stat().st_size > 0
+
+
+def test_draws_depend_only_on_seed_and_index():
+    spec = campaign.parse_spec(SPEC)
+    assert campaign.draw_conditions(spec, 3) == campaign.draw_conditions(spec, 3)
+    assert campaign.draw_conditions(spec, 3) != campaign.draw_conditions(spec, 4)
+    other = campaign.parse_spec(dict(SPEC, seed=8))
+    assert campaign.draw_conditions(other, 3) != campaign.draw_conditions(spec, 3)
+
+
+@pytest.mark.parametrize('change, message', [
+    ({'kinds': ['circle']}, 'kinds must be'),
+    ({'runs': 0}, 'runs must be'),
+    ({'draws': dict(SPEC['draws'], beach_slope_deg={'uniform': [6.0, 3.0]})},
+     'draws.beach_slope_deg.uniform'),
+    ({'draws': dict(SPEC['draws'], significant_wave_height_m={'normal': [0, 1]})},
+     'draws.significant_wave_height_m must be'),
+    ({'draws': dict(SPEC['draws'], soil_preset='moon_dust')}, "unknown preset 'moon_dust'"),
+    ({'draws': {k: v for k, v in SPEC['draws'].items() if k != 'speed_mps'}},
+     'draws.speed_mps is missing'),
+    ({'faults': {'imu_melt': {}}}, 'unknown field'),
+    ({'targets': {'slip_rmse': 0.05}}, 'targets.volume_error_pct'),
+    ({'colour': 'red'}, "unknown field(s) ['colour']"),
+])
+def test_spec_errors_are_refused_with_the_field_named(change, message, tmp_path, capsys):
+    with pytest.raises(campaign.SpecError) as err:
+        campaign.parse_spec(dict(SPEC, **change))
+    assert message in str(err.value)
+    path = _write_spec(tmp_path / 'bad.yaml', dict(SPEC, **change))
+    assert campaign_cli.main([path, '--out', str(tmp_path / 'out')]) == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / 'out').exists()
+
+
+def test_campaign_on_a_given_scheduler_address(twice, tmp_path):
+    """--scheduler: the runs go to an existing cluster, which the campaign leaves running."""
+    from distributed import Client, LocalCluster
+    spec, (first, _) = twice
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=':0') as cluster:
+        out = tmp_path / 'out'
+        assert campaign_cli.main([spec, '--runs', '3', '--scheduler', cluster.scheduler_address,
+                                  '--out', str(out), '--no-progress']) == 0
+        with Client(cluster.scheduler_address) as client:
+            assert len(client.scheduler_info()['workers']) == 2
+    expected = _rows(first)[:3]
+    for ra, rb in zip(expected, _rows(out), strict=True):
+        assert {k: v for k, v in ra.items() if k not in NOT_COMPARED} == {
+            k: v for k, v in rb.items() if k not in NOT_COMPARED}
+
+
+def test_gps_faults_drop_fixes_in_the_window_and_throw_one_outlier():
+    from dukw_sim.sensors import GpsFix, GpsVelocity
+    cond = {'gps_dropout': True, 'gps_dropout_start_s': 1.0, 'gps_dropout_duration_s': 0.5,
+            'gps_outlier': True, 'gps_outlier_start_s': 2.0, 'gps_outlier_offset_m': 10.0}
+    faults = campaign.SensorFaults(cond)
+
+    def fix(t):
+        return GpsFix(t, 36.0, -75.0, 0.0, (0.1, 0.1, 0.2))
+
+    assert faults([fix(1.2), GpsVelocity(1.2, (1.0, 0.0, 0.0), (0.1, 0.1, 0.1))]) == []
+    assert faults([fix(1.5)]) == [fix(1.5)]
+    moved = faults([fix(2.0)])[0]
+    north_m = math.radians(moved.latitude_deg - 36.0) * campaign.EARTH_RADIUS_M
+    east_m = (math.radians(moved.longitude_deg + 75.0) * campaign.EARTH_RADIUS_M
+              * math.cos(math.radians(36.0)))
+    assert math.hypot(north_m, east_m) == pytest.approx(10.0, rel=1e-3)
+    assert faults([fix(2.1)]) == [fix(2.1)]           # one outlier only
+
+
+def test_the_estimator_keeps_its_configured_beach_while_the_simulator_draws_another():
+    spec = campaign.parse_spec(SPEC)
+    cond = dict(campaign.draw_conditions(spec, 0), beach_slope_deg=6.0, friction_angle_deg=15.0)
+    cond['sim.physics.dt_s'] = 0.01
+    loop = campaign.build_loop(spec, cond)
+    assert loop.sim.vehicle.site.beach_slope_rad == pytest.approx(math.radians(6.0))
+    assert loop.sim.vehicle.soil.friction_angle_rad == pytest.approx(math.radians(15.0))
+    configured = campaign.node_params('ekf_node')
+    assert loop.est.vehicle.site.beach_slope_rad == configured['site.beach_slope_rad']
+    assert loop.est.soil.friction_angle_rad == configured['soil.friction_angle_rad']
