@@ -18,6 +18,7 @@ import hashlib
 import hmac
 import json
 import os
+import secrets
 import struct
 import time
 from collections import Counter
@@ -71,15 +72,23 @@ def load_key(path: str | os.PathLike) -> bytes:
     return parse_key(data, f'signing_key_file {str(path)!r}')
 
 
-def generate_key_file(path: str | os.PathLike) -> bytes:
-    """Write a new random key as 64 hex characters (mode 0600); return the key."""
-    key = os.urandom(KEY_BYTES)
+def key_from_passphrase(passphrase: str) -> bytes:
+    """The 32-byte key QGroundControl and MAVProxy (``signing key PASSPHRASE``) derive: SHA-256."""
+    return hashlib.sha256(passphrase.encode('utf-8')).digest()
+
+
+def generate_key_file(path: str | os.PathLike) -> tuple[bytes, str]:
+    """Make a random passphrase; write its key as 64 hex characters to ``path`` and the
+    passphrase to ``<path>.passphrase`` (both mode 0600); return (key, passphrase)."""
+    passphrase = secrets.token_urlsafe(18)
+    key = key_from_passphrase(passphrase)
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
-    with os.fdopen(fd, 'w') as handle:
-        handle.write(key.hex() + '\n')
-    return key
+    path.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
+    for target, text in ((path, key.hex()), (Path(f'{path}.passphrase'), passphrase)):
+        fd = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+        with os.fdopen(fd, 'w') as handle:
+            handle.write(text + '\n')
+    return key, passphrase
 
 
 StreamKey = tuple[int, int, int]   # (link id, system id, component id)

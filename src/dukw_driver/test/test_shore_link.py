@@ -9,7 +9,8 @@ from pymavlink.dialects.v20 import common as mavlink
 
 from dukw_common.config import ConfigError, node_params
 from dukw_driver.mavlink_signing import (SecureSigning, TimestampStore, generate_key_file,
-                                         load_key, parse_key, signing_timestamp)
+                                         key_from_passphrase, load_key, parse_key,
+                                         signing_timestamp)
 from dukw_driver.shore_link import (DriveCommand, MissionHold, MissionPlan, ModeRequest,
                                     ShoreLink, settings_from_params)
 from dukw_driver.shore_telemetry import Drive, Fix, Pose, TractionState
@@ -41,8 +42,9 @@ def test_key_is_32_raw_bytes_or_64_hex_characters(tmp_path):
     for bad in (b'', b'short', KEY + b'x', b'zz' * 32):
         with pytest.raises(ConfigError, match='32 raw bytes or 64 hex'):
             parse_key(bad)
-    key = generate_key_file(tmp_path / 'k' / 'shore.key')
-    assert load_key(tmp_path / 'k' / 'shore.key') == key
+    key, passphrase = generate_key_file(tmp_path / 'k' / 'shore.key')
+    assert load_key(tmp_path / 'k' / 'shore.key') == key == key_from_passphrase(passphrase)
+    assert (tmp_path / 'k' / 'shore.key.passphrase').read_text().strip() == passphrase
     assert (tmp_path / 'k' / 'shore.key').stat().st_mode & 0o077 == 0
     with pytest.raises(ConfigError, match='cannot read'):
         load_key(tmp_path / 'missing.key')

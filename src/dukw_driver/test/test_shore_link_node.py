@@ -1,4 +1,4 @@
-"""shore_link_node against a real pymavlink ground station over UDP loopback and over a pty radio."""
+"""shore_link_node against a real pymavlink ground station over UDP loopback and a pty radio."""
 import json
 import os
 import time
@@ -32,7 +32,7 @@ def odometry(x_m):
 
 
 class UdpGraph(NodeGraph):
-    """The node on udpout to a mavutil ground station (udpin, signed); the probe plays the stack."""
+    """The node on udpout to a signed mavutil ground station (udpin); the probe is the stack."""
 
     def __init__(self, probe, executor, key_file, **overrides):
         os.environ['MAVLINK20'] = '1'          # mavutil: the MAVLink 2 common dialect
