@@ -28,7 +28,7 @@ from dukw_common.config import ConfigError
 from dukw_common.diagnostics import Health, Level
 from dukw_driver.mavlink_signing import SecureSigning
 from dukw_driver.shore_mission import MissionProtocol, PlanWaypoint
-from dukw_driver.shore_params import FailsafeAction, ParamTable, Tuning
+from dukw_driver.shore_params import STREAM_PARAM_NAMES, FailsafeAction, ParamTable, Tuning
 from dukw_driver.shore_telemetry import (HOLDER_NAMES, MODE_NAMES, MODE_SAFE_STOP, STREAM_IDS,
                                          Datum, Drive, RateScheduler, TelemetryEncoder,
                                          VehicleState)
@@ -299,15 +299,10 @@ class ShoreLink:
             return mavlink.MAV_RESULT_ACCEPTED            # the default: keep the current rate
         rate = 0.0 if interval_us < 0 else 1e6 / interval_us
         name = streams[0]
-        if not self.params.set(self._stream_param(name), rate):
+        if not self.params.set(STREAM_PARAM_NAMES[name], rate):
             return mavlink.MAV_RESULT_DENIED
         self.scheduler.set_rate(name, rate)
         return mavlink.MAV_RESULT_ACCEPTED
-
-    @staticmethod
-    def _stream_param(stream: str) -> str:
-        from dukw_driver.shore_params import STREAM_PARAM_NAMES
-        return STREAM_PARAM_NAMES[stream]
 
     def _mode(self, base_mode: int, custom_mode: int, command: int, gcs) -> list:
         if not base_mode & mavlink.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED or not (
@@ -402,9 +397,12 @@ class ShoreLink:
             self.statustext('error', f'{which} fault: {", ".join(new_faults)}')
         setattr(self.state, which, drive)
 
-    def update_mission(self, index: int, reached: int, finished: bool) -> None:
-        """mission/status: MISSION_ITEM_REACHED for each newly reached waypoint."""
+    def update_mission(self, index: int, reached: int, finished: bool, total: int) -> None:
+        """mission/status: MISSION_ITEM_REACHED for each newly reached waypoint (a status of
+        another mission than the one uploaded, e.g. from before the upload, is ignored)."""
         seqs = self.mission.waypoint_seqs
+        if seqs and total != len(seqs):
+            return
         while self.mission_reached < reached:
             i = self.mission_reached
             self._send(self.mav.mission_item_reached_encode(seqs[i] if i < len(seqs) else i))

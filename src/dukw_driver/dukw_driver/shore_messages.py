@@ -79,11 +79,12 @@ def plan_json(plan: MissionPlan) -> str:
          'speed_mps': w.speed_mps} for w in plan.waypoints]})
 
 
-def mission_progress(text: str) -> tuple[int, int, bool] | None:
-    """``mission/status`` JSON -> (waypoint index, waypoints reached, finished); None if bad."""
+def mission_progress(text: str) -> tuple[int, int, bool, int] | None:
+    """``mission/status`` JSON -> (waypoint index, reached, finished, waypoints); None if bad."""
     try:
         data = json.loads(text)
         finished = data['state'] not in ('waiting', 'running')
-        return int(data['waypoint_index']), len(data['reached_s']), finished
+        return (int(data['waypoint_index']), len(data['reached_s']), finished,
+                int(data['waypoints_total']))
     except (ValueError, KeyError, TypeError):
         return None

@@ -308,9 +308,10 @@ def test_mission_upload_download_and_clear():
     link.receive(gcs.pack(gcs.mav.mission_request_int_encode(1, 1, 2, 0)), 1.0)
     gcs.feed(link.take_output())
     assert gcs.of_type('MISSION_ITEM_INT')[-1].command == mavlink.MAV_CMD_NAV_WAYPOINT
-    link.update_mission(1, 1, False)
+    link.update_mission(1, 1, False, 5)            # the old mission's status: not ours
+    link.update_mission(1, 1, False, 2)
     gcs.feed(link.take_output())
-    assert gcs.of_type('MISSION_ITEM_REACHED')[-1].seq == 1
+    assert [m.seq for m in gcs.of_type('MISSION_ITEM_REACHED')] == [1]
     started = link.receive(gcs.command(mavlink.MAV_CMD_MISSION_START), 2.0)
     assert started == [MissionHold(False)]
     bad = upload(link, gcs, [lambda seq: gcs.mav.mission_item_int_encode(
