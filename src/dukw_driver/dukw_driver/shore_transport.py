@@ -16,7 +16,7 @@ import serial
 from pymavlink import mavutil
 
 from dukw_common.config import ConfigError
-from dukw_driver.serial_link import STANDARD_BAUDS
+from dukw_driver.serial_link import STANDARD_BAUDS, WRITE_TIMEOUT_S
 
 READ_CHUNK = 4096
 MAX_READS = 64
@@ -124,6 +124,9 @@ class MavlinkPort:
             self.last_error = f'cannot open {self.url}: {exc}'
             self._next_attempt_s = now + self.reconnect_period_s
             return False
+        port = getattr(self._conn, 'port', None)
+        if isinstance(port, serial.Serial):
+            port.write_timeout = WRITE_TIMEOUT_S   # a stalled radio must not block the node
         self.connected = True
         self.reconnects += int(self._ever_connected)
         self._ever_connected = True

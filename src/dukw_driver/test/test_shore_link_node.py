@@ -202,11 +202,14 @@ def test_installed_node_over_a_pty_radio_keeps_its_timestamps(tmp_path, key_file
                 return bool(gcs.of_type('HEARTBEAT'))
             assert spin_until(executor, read_radio, 30.0), proc.stop() and proc.stderr
             assert all(m.get_signed() for m in gcs.received)
-            for _ in range(40):
+            assert spin_until(executor, lambda: probe.count_publishers('cmd_vel') > 0, 20.0)
+
+            def joystick():                    # sticks at 0.7 while the radio is read
                 os.write(master, gcs.manual(700))
-                executor.spin_once(timeout_sec=0.02)
-            assert spin_until(executor, lambda: any(c.linear.x == 0.7 for c in cmds), 10.0)
-            assert spin_until(executor, lambda: cmds[-1].linear.x == 0.0, 2.0)
+                read_radio()
+                return any(c.linear.x == 0.7 for c in cmds)
+            assert spin_until(executor, joystick, 15.0)
+            assert spin_until(executor, lambda: read_radio() and cmds[-1].linear.x == 0.0, 2.0)
         finally:
             code = proc.stop()
             os.close(master)
