@@ -36,12 +36,14 @@ fi
 
 # 2. Virtual environment and pinned packages.
 [ -x "$VENV/bin/python" ] || { log "creating .venv"; "$PYTHON" -m venv "$VENV"; }
-deps_hash=$(cat requirements.txt constraints.txt | sha256sum | cut -d' ' -f1)
+deps_hash=$(cat requirements.txt requirements-nodeps.txt constraints.txt | sha256sum | cut -d' ' -f1)
 stamp=$VENV/.dukw-deps
 if [ "$(cat "$stamp" 2>/dev/null)" != "$deps_hash" ]; then
-  log "installing pinned Python packages (requirements.txt, constraints.txt)"
+  log "installing pinned Python packages (requirements*.txt, constraints.txt)"
   "$VENV/bin/python" -m pip install -q --disable-pip-version-check \
     -r requirements.txt -c constraints.txt
+  "$VENV/bin/python" -m pip install -q --disable-pip-version-check --no-deps \
+    -r requirements-nodeps.txt
   # The wheels' CMake exports name the include folders of the machine that built them.
   PYINC=$("$VENV/bin/python" -c "import sysconfig; print(sysconfig.get_paths()['include'])")
   NPINC=$("$VENV/bin/python" -c "import numpy; print(numpy.get_include())")

@@ -7,7 +7,7 @@ from ament_index_python.packages import get_package_prefix, get_package_share_di
 
 NODES = {
     'dukw_driver': ['servo_switch_node', 'motor_controller_node', 'imu_gps_node',
-                    'water_sensor_node'],
+                    'water_sensor_node', 'shore_link_node'],
     'dukw_estimation': ['ekf_node'],
     'dukw_control': ['mode_manager_node', 'drive_controller_node'],
     'dukw_sim': ['sim_node'],

@@ -23,6 +23,7 @@ setup(
             'motor_controller_node = dukw_driver.motor_controller_node:main',
             'imu_gps_node = dukw_driver.imu_gps_node:main',
             'water_sensor_node = dukw_driver.water_sensor_node:main',
+            'shore_link_node = dukw_driver.shore_link_node:main',
         ],
     },
 )

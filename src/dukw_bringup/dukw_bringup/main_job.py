@@ -1,10 +1,12 @@
 """main_job: the whole stack on the simulator through the land -> sea -> land mission.
 
-    main_job [--out DIR] [--rtf 2] [--waypoints N] [--time-limit S]   (make run)
+    main_job [--out DIR] [--rtf 2] [--waypoints N] [--time-limit S] [--no-shore-link]
 
 Creates the run folder (default runs/<UTC timestamp>/; see dukw_bringup.run_setup),
-starts the recorder (every topic to bag/, MCAP) and the simulator stack
-(config/stack_sim.yaml) through the bring-up runner, prints the mode changes and
+starts the recorder (every topic to bag/, MCAP), the simulator stack
+(config/stack_sim.yaml) and the shore link (MAVLink 2 to a ground station on
+udpout:127.0.0.1:14550, signed with a key made for the run, outside the repository,
+whose file and passphrase are printed) through the bring-up runner, prints the mode changes and
 one progress line a second, and stops when the mission ends, the time limit
 passes, a node dies or on Ctrl-C. The stack stops in reverse order, the
 recorder last (the bag is closed cleanly, also on Ctrl-C); then summary.json and
@@ -25,8 +27,9 @@ from dukw_bringup.bag_io import BagError
 from dukw_bringup.bringup import Runner, install_stop_signals, load_stack, stack_path
 from dukw_bringup.mission import MissionState, Progress, load_mission
 from dukw_bringup.plot_run import BAG_DIR, render_run
-from dukw_bringup.run_setup import (MONITOR, default_run_dir, format_progress, make_run_dir,
-                                    prepare_run, with_recorder)
+from dukw_bringup.run_setup import (MONITOR, SHORE_URL, default_run_dir, format_progress,
+                                    make_run_dir, make_shore_key, prepare_run, shore_key_path,
+                                    with_recorder, with_shore_link)
 from dukw_bringup.summary import MODE_NAMES, summary_lines, write_summary
 from dukw_common.config import ConfigError, default_config_path
 
@@ -123,6 +126,10 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument('--rtf', type=float, default=1.0,
                         help='real-time factor of the simulator (0 = as fast as possible)')
     parser.add_argument('--waypoints', type=int, help='fly only the first N waypoints')
+    parser.add_argument('--shore-url', default=SHORE_URL,
+                        help=f'where the shore link talks (default {SHORE_URL})')
+    parser.add_argument('--no-shore-link', action='store_true',
+                        help='do not start the shore link')
     parser.add_argument('--time-limit', type=float,
                         help='stop after this many wall seconds (default: mission timeout / '
                              'rtf + 60 s)')
@@ -139,7 +146,15 @@ def run(args: argparse.Namespace, stop: threading.Event) -> int:
         stack = load_stack(stack_path(args.stack))
         run_dir = make_run_dir(args.out or default_run_dir(Path.cwd()))
         stack = with_recorder(stack, run_dir / BAG_DIR)
-        config_copy, overlay = prepare_run(run_dir, config, stack, mission, args.rtf)
+        shore_key = None
+        if not args.no_shore_link:
+            stack, shore_key = with_shore_link(stack), shore_key_path(run_dir)
+            passphrase = make_shore_key(shore_key)
+            print(f'[main_job] shore link: MAVLink 2 on {args.shore_url}, signed; key file '
+                  f'{shore_key}, passphrase for QGroundControl / MAVProxy: {passphrase}',
+                  flush=True)
+        config_copy, overlay = prepare_run(run_dir, config, stack, mission, args.rtf,
+                                           (shore_key, args.shore_url) if shore_key else None)
         runner = Runner(stack, [config_copy, overlay], log_dir=run_dir / 'logs', echo=False)
     except ConfigError as exc:
         print(f'[main_job] FATAL: {exc}', file=sys.stderr)

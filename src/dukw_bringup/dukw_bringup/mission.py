@@ -301,3 +301,28 @@ class LosGuidance:
         if not all(math.isfinite(v) for v in (t_s, x_m, y_m, yaw_rad)):
             raise ValueError(f'guidance needs a finite pose and time, got t={t_s} x={x_m} '
                              f'y={y_m} yaw={yaw_rad}')
+
+
+def spec_with_plan(spec: MissionSpec, text: str) -> MissionSpec | None:
+    """``spec`` with the waypoints of a ``mission/plan`` JSON document; None for an empty plan.
+
+    The document is ``{"waypoints": [{"name", "x_m", "y_m", "speed_mps"}, ...]}`` (odom,
+    as the mission file); raises ConfigError naming what is wrong.
+    """
+    try:
+        doc = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ConfigError(f'mission plan: not JSON ({exc})') from exc
+    if not isinstance(doc, Mapping) or not isinstance(doc.get('waypoints'), list):
+        raise ConfigError('mission plan: needs a "waypoints" list')
+    if not doc['waypoints']:
+        return None
+    tree = {'mission': {**mission_tree(spec), 'waypoints': doc['waypoints']}}
+    return parse_mission(tree)
+
+
+def mission_tree(spec: MissionSpec) -> dict[str, Any]:
+    """The mission-file mapping of ``spec`` (without waypoints)."""
+    tree = asdict(spec)
+    tree.pop('waypoints')
+    return tree

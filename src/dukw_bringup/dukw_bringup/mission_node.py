@@ -3,7 +3,12 @@
 Subscribes ``odometry/filtered`` (nav_msgs/Odometry); publishes ``cmd_vel``
 (geometry_msgs/Twist, reliable) at ``rate_hz`` and ``mission/status``
 (std_msgs/String, one JSON object of dukw_bringup.mission.Progress, latched)
-on every change of state or waypoint and at ``status_rate_hz``. The mission
+on every change of state or waypoint and at ``status_rate_hz``. The shore link
+(or anyone) may replace the waypoints with ``mission/plan`` (std_msgs/String,
+latched: ``{"waypoints": [{name, x_m, y_m, speed_mps}, ...]}``, empty = clear and
+stop) and hold the mission with ``mission/hold`` (std_msgs/Bool, latched): while
+held the node sends one zero velocity and then nothing, so another cmd_vel
+source (the shore's MANUAL_CONTROL) is not fought. The mission
 starts ``start_delay_s`` (mission file) after the first odometry; when it is
 done, timed out or the node stops, it sends zero velocity. Time is the node's
 clock, so with ``use_sim_time`` the mission runs on the simulator's /clock.
@@ -16,9 +21,11 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from rclpy.duration import Duration
 from rclpy.node import Node
-from std_msgs.msg import String
+from std_msgs.msg import Bool, String
 
-from dukw_bringup.mission import LosGuidance, MissionState, VelocityCommand, load_mission
+from dukw_bringup.mission import (LosGuidance, MissionState, VelocityCommand, load_mission,
+                                  spec_with_plan)
+from dukw_common.config import ConfigError
 from dukw_common.geometry import euler_from_quaternion
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
                                     declare_parameters, run_node)
@@ -42,9 +49,12 @@ class MissionNode(Node):
         self.pose_time_s = -math.inf
         self.first_pose_s: float | None = None
         self.last_key: tuple = ()
+        self.held = False
         self.cmd_pub = self.create_publisher(Twist, 'cmd_vel', COMMAND_QOS)
         self.status_pub = self.create_publisher(String, 'mission/status', STATE_QOS)
         self.create_subscription(Odometry, 'odometry/filtered', self.on_odometry, SENSOR_QOS)
+        self.create_subscription(String, 'mission/plan', self.on_plan, STATE_QOS)
+        self.create_subscription(Bool, 'mission/hold', self.on_hold, STATE_QOS)
         self.create_timer(1.0 / float(self.params['rate_hz']), self.on_tick)
         self.create_timer(1.0 / float(self.params['status_rate_hz']), self.publish_status)
         spec = self.guidance.spec
@@ -67,9 +77,33 @@ class MissionNode(Node):
         if self.first_pose_s is None:
             self.first_pose_s = self.pose_time_s
 
+    def on_plan(self, msg: String) -> None:
+        """New waypoints: guidance starts over from where the vehicle is; empty: stop."""
+        try:
+            spec = spec_with_plan(self.guidance.spec, msg.data)
+        except ConfigError as exc:
+            self.get_logger().error(f'mission/plan refused: {exc}')
+            return
+        if spec is None:
+            self.guidance.abort()
+            self.get_logger().info('mission cleared')
+            return
+        self.guidance = LosGuidance(spec)
+        self.last_key = ()
+        self.get_logger().info(f'new plan: {len(spec.waypoints)} waypoints')
+
+    def on_hold(self, msg: Bool) -> None:
+        """Hold (one zero velocity, then silence) or let the mission run."""
+        if msg.data and not self.held:
+            self.publish_command(VelocityCommand())
+        self.held = msg.data
+        self.get_logger().info('mission held' if msg.data else 'mission runs')
+
     def on_tick(self) -> None:
-        """Start when due, advance guidance, publish cmd_vel."""
+        """Start when due, advance guidance, publish cmd_vel (nothing while held)."""
         now = self.now_s()
+        if self.held:
+            return
         progress = self.guidance.progress
         command = VelocityCommand()
         if self.pose is not None and now - self.pose_time_s <= self.params['odometry_timeout_s']:

@@ -20,6 +20,7 @@ from __future__ import annotations
 import datetime as dt
 import math
 import shutil
+import tempfile
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -31,6 +32,10 @@ from dukw_bringup.mission import MissionSpec, Progress
 from dukw_common.config import ConfigError
 
 SIM_NODE = 'sim_node'
+SHORE_NODE = 'shore_link_node'
+#: Where the main job's shore link sends: a ground station's default port on this machine.
+SHORE_URL = 'udpout:127.0.0.1:14550'
+ShoreSetup = tuple[Path, str]      # the shore link's signing key file and url
 RECORDER = 'recorder'
 MONITOR = 'main_job'
 
@@ -72,7 +77,7 @@ def sim_overrides(spec: MissionSpec, real_time_factor: float) -> dict[str, Any]:
 
 
 def write_overlay(path: Path, stack: StackSpec, spec: MissionSpec, mission_file: Path,
-                  real_time_factor: float) -> Path:
+                  real_time_factor: float, shore: ShoreSetup | None = None) -> Path:
     """Write the run's parameter overlay (a ROS 2 parameter file given after dukw.yaml)."""
     doc: dict[str, Any] = {}
     for name in [n.name for n in stack.nodes] + [MONITOR]:
@@ -82,13 +87,17 @@ def write_overlay(path: Path, stack: StackSpec, spec: MissionSpec, mission_file:
             doc[name] = {'ros__parameters': {'use_sim_time': True}}
     if 'mission_node' in doc:
         doc['mission_node']['ros__parameters']['mission_file'] = str(mission_file)
+    if SHORE_NODE in doc:
+        if shore is None:
+            raise ConfigError(f'{SHORE_NODE} in the stack needs a signing key file and a url')
+        doc[SHORE_NODE]['ros__parameters'].update(signing_key_file=str(shore[0]), url=shore[1])
     path.write_text("# The run's overrides of dukw.yaml (written by main_job).\n"
                     + yaml.safe_dump(doc, sort_keys=False))
     return path
 
 
 def prepare_run(run_dir: Path, config: Path, stack: StackSpec, spec: MissionSpec,
-                real_time_factor: float) -> tuple[Path, Path]:
+                real_time_factor: float, shore: ShoreSetup | None = None) -> tuple[Path, Path]:
     """Copy the config, write mission.yaml and the overlay; return (config copy, overlay)."""
     if not (real_time_factor >= 0.0 and math.isfinite(real_time_factor)):
         raise ConfigError(f'real-time factor must be >= 0 (0 = as fast as possible), '
@@ -99,8 +108,26 @@ def prepare_run(run_dir: Path, config: Path, stack: StackSpec, spec: MissionSpec
     mission_file.write_text('# The mission as flown (written by main_job).\n'
                             + yaml.safe_dump(mission_document(spec), sort_keys=False))
     overlay = write_overlay(run_dir / 'params_overlay.yaml', stack, spec, mission_file,
-                            real_time_factor)
+                            real_time_factor, shore)
     return config_copy, overlay
+
+
+def shore_key_path(run_dir: Path) -> Path:
+    """A per-run signing key outside the repository: <tmp>/dukw-shore-keys/<run>.key."""
+    return Path(tempfile.gettempdir()) / 'dukw-shore-keys' / f'{run_dir.name}.key'
+
+
+def make_shore_key(path: Path) -> str:
+    """Write a new signing key (and its passphrase) for the run's shore link; return the
+    passphrase a ground station is given."""
+    from dukw_driver.mavlink_signing import generate_key_file
+    return generate_key_file(path)[1]
+
+
+def with_shore_link(stack: StackSpec) -> StackSpec:
+    """The stack with the shore link last (it needs a per-run key, so the stack files, which
+    ``bringup`` and the launch file also start, do not list it)."""
+    return StackSpec(stack.name, (*stack.nodes, NodeSpec(SHORE_NODE, 'dukw_driver', SHORE_NODE)))
 
 
 def with_recorder(stack: StackSpec, bag_dir: Path) -> StackSpec:

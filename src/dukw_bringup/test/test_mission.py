@@ -138,3 +138,18 @@ def test_cut_mission_keeps_the_first_waypoints():
     assert [wp.name for wp in spec.waypoints] == ['a']
     with pytest.raises(ConfigError):
         spec.with_waypoints(3)
+
+
+def test_a_plan_from_shore_replaces_the_waypoints_and_keeps_the_rest():
+    from dukw_bringup.mission import spec_with_plan
+    spec = load_mission()
+    plan = '{"waypoints": [{"name": "a", "x_m": -6, "y_m": 0, "speed_mps": 0.8}, ' \
+           '{"name": "b", "x_m": -6, "y_m": 4, "speed_mps": 0.8}]}'
+    new = spec_with_plan(spec, plan)
+    assert [(w.name, w.x_m, w.y_m) for w in new.waypoints] == [('a', -6.0, 0.0), ('b', -6.0, 4.0)]
+    assert new.timeout_s == spec.timeout_s and new.start == spec.start
+    assert spec_with_plan(spec, '{"waypoints": []}') is None
+    for bad, message in (('nope', 'not JSON'), ('{}', 'waypoints'),
+                         ('{"waypoints": [{"x_m": 1, "y_m": 0, "speed_mps": 9}]}', 'speed')):
+        with pytest.raises(ConfigError, match=message):
+            spec_with_plan(spec, bad)
