@@ -88,6 +88,7 @@ class _Loop:
         self.writer = writer
         self.store = typestore()
         sim_params = node_params('sim_node', config_path)
+        self.cmd_vel_stamped = bool(sim_params['cmd_vel_stamped'])   # shared block
         self.sim = SimCore.from_config(config_path, seed=scenario.seed)
         self.sim.reset(x_m=scenario.start_x_m, yaw_rad=scenario.start_yaw_rad)
         self.sensors = SensorModel.from_config(config_path, seed=scenario.seed)
@@ -164,7 +165,7 @@ class _Loop:
         from dukw_control.convert import decision_to_msg
         from dukw_sim import sim_messages as sm
         from dukw_sim.core import Actuation
-        from geometry_msgs.msg import Twist
+        from dukw_common.cmd_vel import make_cmd_vel
 
         t_prev_s = self.sim.t_s
         out = self.switch.outputs(t_prev_s)
@@ -184,9 +185,9 @@ class _Loop:
                        everyone)
         if k % 10 == 0:
             speed, yaw_rate = self.scenario.cmd_vel(t_ns * 1e-9)
-            twist = Twist()
-            twist.linear.x, twist.angular.z = float(speed), float(yaw_rate)
-            self._emit('cmd_vel', t_ns + MS_NS // 5, twist, everyone)
+            t_cmd_ns = t_ns + MS_NS // 5
+            self._emit('cmd_vel', t_cmd_ns, make_cmd_vel(self.cmd_vel_stamped, speed, yaw_rate,
+                                                         t_cmd_ns * 1e-9), everyone)
         if self.ekf_pending is not None:           # the EKF published on the IMU sample
             self._publish_estimates(t_ns + MS_NS // 2, self.ekf_pending)
             self.ekf_pending = None

@@ -1,7 +1,8 @@
 """mission_node: line-of-sight waypoint guidance on ``cmd_vel`` from ``odometry/filtered``.
 
 Subscribes ``odometry/filtered`` (nav_msgs/Odometry); publishes ``cmd_vel``
-(geometry_msgs/Twist, reliable) at ``rate_hz`` and ``mission/status``
+(geometry_msgs/TwistStamped stamped with the node's clock, or Twist:
+the shared ``cmd_vel_stamped``; reliable) at ``rate_hz`` and ``mission/status``
 (std_msgs/String, one JSON object of dukw_bringup.mission.Progress, latched)
 on every change of state or waypoint and at ``status_rate_hz``. The mission
 starts ``start_delay_s`` (mission file) after the first odometry; when it is
@@ -12,13 +13,13 @@ from __future__ import annotations
 
 import math
 
-from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from rclpy.duration import Duration
 from rclpy.node import Node
 from std_msgs.msg import String
 
 from dukw_bringup.mission import LosGuidance, MissionState, VelocityCommand, load_mission
+from dukw_common.cmd_vel import CMD_VEL_STAMPED_SPEC, cmd_vel_type, make_cmd_vel
 from dukw_common.geometry import euler_from_quaternion
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
                                     declare_parameters, run_node)
@@ -36,13 +37,15 @@ class MissionNode(Node):
             ParamSpec('mission_file', "mission YAML; '' = config/mission.yaml"),
             ParamSpec('odometry_timeout_s', 'stop (zero cmd_vel) while odometry is older, s',
                       min=0.05, max=10.0),
+            CMD_VEL_STAMPED_SPEC,
         ])
+        self.stamped = bool(self.params['cmd_vel_stamped'])
         self.guidance = LosGuidance(load_mission(str(self.params['mission_file']) or None))
         self.pose: tuple[float, float, float] | None = None
         self.pose_time_s = -math.inf
         self.first_pose_s: float | None = None
         self.last_key: tuple = ()
-        self.cmd_pub = self.create_publisher(Twist, 'cmd_vel', COMMAND_QOS)
+        self.cmd_pub = self.create_publisher(cmd_vel_type(self.stamped), 'cmd_vel', COMMAND_QOS)
         self.status_pub = self.create_publisher(String, 'mission/status', STATE_QOS)
         self.create_subscription(Odometry, 'odometry/filtered', self.on_odometry, SENSOR_QOS)
         self.create_timer(1.0 / float(self.params['rate_hz']), self.on_tick)
@@ -93,10 +96,8 @@ class MissionNode(Node):
 
     def publish_command(self, command: VelocityCommand) -> None:
         """Send one cmd_vel."""
-        twist = Twist()
-        twist.linear.x = float(command.speed_mps)
-        twist.angular.z = float(command.yaw_rate_rps)
-        self.cmd_pub.publish(twist)
+        self.cmd_pub.publish(make_cmd_vel(self.stamped, command.speed_mps,
+                                          command.yaw_rate_rps, self.now_s()))
 
     def publish_status(self) -> None:
         """Send the progress as JSON."""
