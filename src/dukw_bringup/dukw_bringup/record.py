@@ -85,13 +85,7 @@ class Recorder:
             self._subscribe(topic, msgtype, [p.qos_profile for p in publishers])
 
     def _subscribe(self, topic: str, msgtype: str, offered: list[QoSProfile]) -> None:
-        reliable = all(q.reliability == ReliabilityPolicy.RELIABLE for q in offered)
-        latched = all(q.durability == DurabilityPolicy.TRANSIENT_LOCAL for q in offered)
-        qos = QoSProfile(
-            history=HistoryPolicy.KEEP_LAST, depth=RECORD_DEPTH,
-            reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
-            durability=(DurabilityPolicy.TRANSIENT_LOCAL if latched
-                        else DurabilityPolicy.VOLATILE))
+        qos = matching_qos(offered, RECORD_DEPTH)
         self.writer.add_topic(topic, msgtype, [
             make_qos(reliable=q.reliability == ReliabilityPolicy.RELIABLE,
                      transient_local=q.durability == DurabilityPolicy.TRANSIENT_LOCAL,
@@ -114,6 +108,17 @@ class Recorder:
             self.node.destroy_subscription(subscription)
         self._subscriptions.clear()
         self.writer.close()
+
+
+def matching_qos(offered: list[QoSProfile], depth: int) -> QoSProfile:
+    """A subscription that matches every publisher: reliable only if all are, transient
+    local when all are (so latched values arrive)."""
+    reliable = all(q.reliability == ReliabilityPolicy.RELIABLE for q in offered)
+    latched = all(q.durability == DurabilityPolicy.TRANSIENT_LOCAL for q in offered)
+    return QoSProfile(
+        history=HistoryPolicy.KEEP_LAST, depth=depth,
+        reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
+        durability=DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE)
 
 
 def message_class(msgtype: str):

@@ -33,6 +33,7 @@ from dukw_common.config import ConfigError
 SIM_NODE = 'sim_node'
 RECORDER = 'recorder'
 MONITOR = 'main_job'
+LIVE_VIEW = 'live_view_node'
 
 
 def default_run_dir(root: Path, now: dt.datetime | None = None) -> Path:
@@ -80,6 +81,9 @@ def write_overlay(path: Path, stack: StackSpec, spec: MissionSpec, mission_file:
             doc[name] = {'ros__parameters': sim_overrides(spec, real_time_factor)}
         else:
             doc[name] = {'ros__parameters': {'use_sim_time': True}}
+    if LIVE_VIEW in doc:                # draws the same sea as the simulator
+        sea = sim_overrides(spec, real_time_factor)
+        doc[LIVE_VIEW]['ros__parameters'].update(seed=sea['seed'], waves=sea['waves'])
     if 'mission_node' in doc:
         doc['mission_node']['ros__parameters']['mission_file'] = str(mission_file)
     path.write_text("# The run's overrides of dukw.yaml (written by main_job).\n"
