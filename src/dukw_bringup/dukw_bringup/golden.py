@@ -12,8 +12,9 @@ replay uses (``replay_adapters``), fed with the messages as decoded from their C
 bytes, on the nodes' timer grids with fixed offsets inside each step:
 
     T        sensor messages of the step (stamped T), authority, cmd_vel (+0.1/0.2 ms)
+    0        robot_description and /tf_static (latched), as robot_state_node sends them
     T+0.5 ms the EKF's output on the IMU sample: odometry/filtered (the controller steps
-             on it: tracks/cmd, props/cmd at +0.5 us), traction (+1 us)
+             on it: tracks/cmd, props/cmd at +0.5 us), traction (+1 us), /tf (+2 us)
     T+1 ms   ekf timer tick (publishes only while the IMU is silent)
     T+2 ms   mode manager tick (every 5th step at 20 Hz): drive_mode on change or 1 s
     T+3 ms   controller timer tick (if it steps): tracks/cmd, props/cmd -> servo switch;
@@ -86,6 +87,7 @@ class _Loop:
                                                   ModeManagerAdapter)
         self.scenario = scenario
         self.writer = writer
+        self.config_path = config_path
         self.store = typestore()
         sim_params = node_params('sim_node', config_path)
         self.cmd_vel_stamped = bool(sim_params['cmd_vel_stamped'])   # shared block
@@ -154,10 +156,12 @@ class _Loop:
                 traction_msg(est.traction(), stamp, Traction))
 
     def _publish_estimates(self, t_ns: int, messages: tuple) -> None:
-        """As ekf_node: odometry, then traction (1 us later, so the order is in the bag)."""
+        """As ekf_node: odometry, then traction and /tf (1 and 2 us later, in that order)."""
+        from dukw_common.tf_tools import odometry_tf
         everyone = (self.ekf, self.modes, self.controller)
         self._emit('odometry/filtered', t_ns, messages[0], everyone)
         self._emit('traction', t_ns + 1_000, messages[1], everyone)
+        self._emit('tf', t_ns + 2_000, odometry_tf(messages[0]))
 
     # --- one step --------------------------------------------------------------------
     def step(self, k: int) -> None:
@@ -214,7 +218,23 @@ class _Loop:
         if out is not None:
             self._command(t_ctrl, out)
 
+    def _describe(self) -> None:
+        """robot_description and /tf_static at t = 0, as robot_state_node."""
+        from dukw_common.config import node_params
+        from dukw_common.description import FrameNames, VehicleModel
+        from dukw_common.node_tools import s_to_stamp
+        from dukw_common.tf_tools import tf_message
+        from dukw_common.vehicle import Vehicle
+        from std_msgs.msg import String
+        params = node_params('robot_state_node', self.config_path)
+        vehicle = Vehicle.from_params(params)
+        model = VehicleModel.build(vehicle.body, vehicle.sensors, FrameNames.from_params(params),
+                                   float(params['deck_thickness_m']))
+        self._emit('robot_description', 0, String(data=model.urdf()))
+        self._emit('tf_static', 0, tf_message(model.static_transforms(), s_to_stamp(0.0)))
+
     def run(self) -> None:
+        self._describe()
         steps = round(self.scenario.duration_s * 1e9 / self.step_ns)
         for k in range(1, steps + 1):
             self.step(k)
