@@ -5,10 +5,10 @@ config/foxglove/dukw_layout.json:
     python -m dukw_bringup.live_layout config/foxglove/dukw_layout.json
 
 3D (the URDF from robot_description over the /live/scene beach and water, following
-base_link in odom, the true pose's ghost), the map (gps/fix and /live/gps), plots of
-slip, submersion, track and propeller currents against the continuous limit, speed, and
-the drive mode as a state timeline. Everything but /live/* is a recorded ROS topic, so the
-same layout opens a run's bag.
+base_link in odom, the true pose's ghost; in a bag the beach is live_view/beach), the map
+(gps/fix and /live/gps), plots of slip, submersion, track and propeller currents against
+the continuous limit, speed, and the drive mode as a state timeline. Everything but
+/live/* is a recorded ROS topic, so the same layout opens a run's bag.
 """
 from __future__ import annotations
 
@@ -29,7 +29,8 @@ def _plot(title: str, series: list[tuple[str, str]], y_label: str) -> fl.PlotPan
 def _three_d() -> fl.ThreeDeePanel:
     return fl.ThreeDeePanel(title='vehicle on the beach', config=fl.ThreeDeeConfig(
         follow_tf='base_link', fixed_frame='odom',
-        topics={'/live/scene': fl.BaseRendererSceneUpdateTopicSettings(visible=True)},
+        topics={'/live/scene': fl.BaseRendererSceneUpdateTopicSettings(visible=True),
+                '/live_view/beach': fl.BaseRendererRosMarkerTopicSettings(visible=True)},
         layers={'grid': fl.BaseRendererGridLayerSettings(layer_id='foxglove.Grid'),
                 'urdf': fl.BaseRendererUrdfLayerSettings(
                     layer_id='foxglove.Urdf', source_type='topic',

@@ -103,11 +103,17 @@ class LiveScene:
     def water(self, t_s: float) -> Mesh:
         """The water surface at ``t_s``, only where it is above the ground."""
         if self.surface is None:
-            eta = np.zeros_like(self._xx)
-        else:
-            eta = self.surface(self._xx.ravel(), self._yy.ravel(), t_s).reshape(self._xx.shape)
-        ground = self.ground(self._xx, self._yy)
-        return grid_mesh('water', self.x, self.y, np.maximum(eta, ground - 0.01), WATER_RGBA)
+            return self._water('water', np.zeros_like(self._xx))
+        eta = self.surface(self._xx.ravel(), self._yy.ravel(), t_s).reshape(self._xx.shape)
+        return self._water('water', eta)
+
+    def sea_level(self) -> Mesh:
+        """The mean sea level (fixed)."""
+        return self._water('sea_level', np.zeros_like(self._xx))
+
+    def _water(self, name: str, eta: np.ndarray) -> Mesh:
+        ground = self.ground(self._xx, self._yy)   # below the sand where it is dry
+        return grid_mesh(name, self.x, self.y, np.maximum(eta, ground - 0.01), WATER_RGBA)
 
 
 @dataclass(frozen=True)

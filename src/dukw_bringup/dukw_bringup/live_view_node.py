@@ -6,6 +6,8 @@ any field. On top, scene entities (live_scene, drawn on ``/live/scene``): the be
 moving water surface (the simulator's own wave field with ``sim_world``), the vehicle in
 base_link and its true pose as a ghost; the GPS track as LocationFix on ``/live/gps``;
 ``/live/limits`` (JSON) carries the continuous current limit for the current plots.
+The beach and the mean sea level also go on ROS, latched (``live_view/beach``,
+visualization_msgs/MarkerArray), so a run's bag draws them.
 The server's URL is logged and latched on ``live_view/url`` (std_msgs/String).
 """
 from __future__ import annotations
@@ -14,9 +16,11 @@ import foxglove
 from rclpy.node import Node
 from sensor_msgs.msg import NavSatFix
 from std_msgs.msg import String
+from visualization_msgs.msg import MarkerArray
 
 from dukw_bringup import live_foxglove as fg
 from dukw_bringup.live_forward import GraphForwarder
+from dukw_bringup.live_markers import beach_markers
 from dukw_bringup.live_scene import (TRUTH_ALPHA, LiveScene, SceneArea, sim_world_fields,
                                      site_ground, vehicle_parts)
 from dukw_common.config import ConfigError
@@ -63,6 +67,9 @@ class LiveViewNode(Node):
         self.get_logger().info(f'Foxglove live view: {self.url} (Open connection -> '
                                'Foxglove WebSocket; layout config/foxglove/dukw_layout.json)')
         self.create_publisher(String, 'live_view/url', STATE_QOS).publish(String(data=self.url))
+        self.create_publisher(MarkerArray, 'live_view/beach', STATE_QOS).publish(beach_markers(
+            self.scene.beach(), self.scene.sea_level(), p['frames.odom'],
+            self.get_clock().now().to_msg()))
         self.scene_ch = foxglove.channels.SceneUpdateChannel('/live/scene')
         self.gps_ch = foxglove.channels.LocationFixChannel('/live/gps')
         self.limits_ch = foxglove.Channel('/live/limits')

@@ -9,7 +9,7 @@ from dukw_common.vehicle import Vehicle
 LAYOUT = Path(__file__).resolve().parents[3] / 'config' / 'foxglove' / 'dukw_layout.json'
 #: Topics a main-job bag holds (test_main_job checks them) and the live view's own.
 RECORDED = {'/traction', '/sim/truth', '/tracks/status', '/props/status', '/odometry/filtered',
-            '/cmd_vel', '/drive_mode', '/gps/fix', '/robot_description'}
+            '/cmd_vel', '/drive_mode', '/gps/fix', '/robot_description', '/live_view/beach'}
 LIVE_ONLY = {'/live/scene', '/live/limits'}
 
 

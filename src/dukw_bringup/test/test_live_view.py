@@ -18,7 +18,13 @@ from dukw_common.vehicle import Vehicle
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 STARTUP_S = 60.0
 WANTED = {'/tf', '/tf_static', '/robot_description', '/sim/truth', '/gps/fix',
-          '/live/scene', '/live/gps', '/live/limits'}
+          '/live/scene', '/live/gps', '/live/limits', '/live_view/beach'}
+
+
+def complete(received: dict) -> bool:
+    """Every wanted topic came, and a scene update with the (moving) water surface."""
+    return all(received.get(t) for t in WANTED) and any(
+        b'water' in m for m in received['/live/scene'])
 
 
 async def watch(url: str, seconds: float) -> tuple[dict, dict]:
@@ -28,7 +34,7 @@ async def watch(url: str, seconds: float) -> tuple[dict, dict]:
         loop = asyncio.get_running_loop()
         deadline = loop.time() + seconds
         subscribed: dict[int, str] = {}
-        while loop.time() < deadline and not all(received.get(t) for t in WANTED):
+        while loop.time() < deadline and not complete(received):
             try:
                 frame = await asyncio.wait_for(ws.recv(), deadline - loop.time())
             except asyncio.TimeoutError:
@@ -76,4 +82,8 @@ def test_a_websocket_client_gets_the_graph_and_the_scene():
     assert {'imu_link', 'gps_link', 'port_hull'} <= {t.child_frame_id for t in static.transforms}
     limit_a = Vehicle.load().drivetrain.continuous_current_limit_a
     assert json.loads(received['/live/limits'][-1]) == {'continuous_current_limit_a': limit_a}
-    assert b'water' in b''.join(received['/live/scene'])      # the entities' ids
+    assert complete(received)                   # incl. the water entity (its id in the bytes)
+    beach = store.deserialize_cdr(received['/live_view/beach'][-1],
+                                  'visualization_msgs/msg/MarkerArray')
+    assert [m.ns for m in beach.markers] == ['beach', 'sea_level']
+    assert all(m.header.frame_id == 'odom' and len(m.points) % 3 == 0 for m in beach.markers)
