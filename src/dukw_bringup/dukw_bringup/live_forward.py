@@ -10,9 +10,12 @@ topic (/tf_static, robot_description, authority, drive_mode) is logged again eve
 """
 from __future__ import annotations
 
+from typing import Callable
+
 import foxglove
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy
+from rclpy.serialization import deserialize_message
 
 from dukw_bringup.bag_io import typestore
 from dukw_bringup.record import IGNORED_BY_DEFAULT, matching_qos, message_class
@@ -22,10 +25,16 @@ FORWARD_DEPTH = 100
 
 
 class GraphForwarder:
-    """Forward every topic of ``node``'s graph to Foxglove channels (call ``scan``)."""
+    """Forward every topic of ``node``'s graph to Foxglove channels (call ``scan``).
 
-    def __init__(self, node: Node) -> None:
+    ``taps``: topic -> callback that also gets the topic's messages, decoded from the same
+    subscription (one subscription per topic).
+    """
+
+    def __init__(self, node: Node,
+                 taps: dict[str, Callable[[object], None]] | None = None) -> None:
         self.node = node
+        self.taps = dict(taps or {})
         self.store = typestore()
         self.channels: dict[str, foxglove.Channel] = {}
         self.latched: dict[str, bytes] = {}
@@ -56,13 +65,16 @@ class GraphForwarder:
         self.channels[topic] = channel
         qos = matching_qos(offered, FORWARD_DEPTH)
         latched = qos.durability == DurabilityPolicy.TRANSIENT_LOCAL
+        cls, tap = message_class(msgtype), self.taps.get(topic)
 
         def on_message(raw: bytes) -> None:
             channel.log(raw, log_time=self._now_ns())
             if latched:
                 self.latched[topic] = raw
+            if tap is not None:
+                tap(deserialize_message(raw, cls))
         self._subscriptions[topic] = self.node.create_subscription(
-            message_class(msgtype), topic, on_message, qos, raw=True)
+            cls, topic, on_message, qos, raw=True)
 
     def relog_latched(self) -> None:
         """Log the last message of each latched topic again (for late viewers)."""

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import foxglove
 from rclpy.node import Node
-from sensor_msgs.msg import NavSatFix
 from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
@@ -25,7 +24,7 @@ from dukw_bringup.live_scene import (TRUTH_ALPHA, LiveScene, SceneArea, sim_worl
                                      site_ground, vehicle_parts)
 from dukw_common.config import ConfigError
 from dukw_common.description import FrameNames, VehicleModel
-from dukw_common.node_tools import (SENSOR_QOS, STATE_QOS, ParamSpec, declare_parameters,
+from dukw_common.node_tools import (STATE_QOS, ParamSpec, declare_parameters,
                                     run_node, vehicle_specs)
 from dukw_common.vehicle import Vehicle
 
@@ -73,8 +72,8 @@ class LiveViewNode(Node):
         self.scene_ch = foxglove.channels.SceneUpdateChannel('/live/scene')
         self.gps_ch = foxglove.channels.LocationFixChannel('/live/gps')
         self.limits_ch = foxglove.Channel('/live/limits')
-        self.forwarder = GraphForwarder(self)
-        self.create_subscription(NavSatFix, 'gps/fix', self.on_fix, SENSOR_QOS)
+        self.forwarder = GraphForwarder(self, taps={self.resolve_topic_name('gps/fix'):
+                                                    self.on_fix})
         self.create_timer(p['rescan_period_s'], self.forwarder.scan)
         self.create_timer(1.0 / p['water_rate_hz'], self.on_water)
         self.create_timer(p['latched_period_s'], self.on_latched)
@@ -116,7 +115,8 @@ class LiveViewNode(Node):
             log_time=t_ns)
         self.limits_ch.log({'continuous_current_limit_a': self.current_limit_a}, log_time=t_ns)
 
-    def on_fix(self, msg: NavSatFix) -> None:
+    def on_fix(self, msg) -> None:
+        """sensor_msgs/NavSatFix -> LocationFix on the map."""
         t_ns = self.now_ns()
         cov = [msg.position_covariance[i] for i in range(9)]
         self.gps_ch.log(fg.location_fix(t_ns, msg.header.frame_id, msg.latitude,
