@@ -61,19 +61,30 @@ else
   log "Python packages up to date"
 fi
 
-# 3. Build the workspace (skipped when nothing under src/ or config/ changed).
+# 3. Build the workspace (skipped when nothing under src/, compat/ or config/ changed).
+# tf2_msgs (TFMessage for /tf, /tf_static): the wheels have none, a ROS install has it.
+# compat/tf2_msgs is built only when Python cannot import one without this workspace
+# (compat/COLCON_IGNORE keeps a plain `colcon build` on a ROS install from shadowing it).
+base_paths=(src)
+outside_pythonpath=$(printf '%s' "${PYTHONPATH:-}" | tr ':' '\n' | grep -v "^$ROOT/install" \
+  | paste -sd: - || true)
+if ! PYTHONPATH=$outside_pythonpath "$VENV/bin/python" -c 'import tf2_msgs.msg' 2>/dev/null
+then
+  base_paths+=(compat/tf2_msgs)
+fi
 build_stamp=$ROOT/install/.dukw-build
-if [ -f "$build_stamp" ] && [ -z "$(find src config -newer "$build_stamp" -print -quit)" ]; then
+if [ -f "$build_stamp" ] && [ -z "$(find src compat config -newer "$build_stamp" -print -quit)" ]
+then
   log "workspace build up to date"
 else
-  log "colcon build --merge-install"
+  log "colcon build --merge-install (${base_paths[*]})"
   set +u
   # shellcheck disable=SC1091
   source "$VENV/bin/activate"
   set -u
   export AMENT_PREFIX_PATH=$VENV CMAKE_PREFIX_PATH=$VENV
   colcon --log-base log build --merge-install --symlink-install \
-    --base-paths src --build-base build --install-base install --event-handlers console_start_end- \
+    --base-paths "${base_paths[@]}" --build-base build --install-base install --event-handlers console_start_end- \
     --cmake-args -DBUILD_TESTING=OFF -DPython3_EXECUTABLE="$VENV/bin/python" \
     > "$ROOT/.colcon-build.txt" 2>&1 || { tail -50 "$ROOT/.colcon-build.txt" >&2; exit 1; } 
   touch "$build_stamp"

@@ -5,7 +5,7 @@ this process against fake devices on ptys (src/dukw_driver/test/fake_*.py and th
 part-B fakes in that folder's tests) until every topic they publish has carried a
 message; then sim_node runs as its own process, and the published topic names
 and types of the two graphs are compared, leaving out what only the simulator
-has (sim/truth, /clock) and what every node has (/rosout, /parameter_events).
+has (sim/truth, /clock, its true pose on /tf) and what every node has (/rosout, /parameter_events).
 """
 import importlib
 import sys
@@ -24,7 +24,7 @@ from fake_maestro import FakeMaestro  # noqa: E402
 from fake_roboteq import FakeRoboteq  # noqa: E402
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
-IGNORED = {'/rosout', '/parameter_events', '/clock', '/sim/truth'}
+IGNORED = {'/rosout', '/parameter_events', '/clock', '/sim/truth', '/tf'}
 DRIVERS = ['servo_switch_node', 'motor_controller_node', 'props_motor_controller_node',
            'imu_gps_node', 'water_sensor_node']
 

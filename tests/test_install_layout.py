@@ -11,6 +11,7 @@ NODES = {
     'dukw_estimation': ['ekf_node'],
     'dukw_control': ['mode_manager_node', 'drive_controller_node'],
     'dukw_sim': ['sim_node'],
+    'dukw_bringup': ['mission_node', 'robot_state_node', 'live_view_node'],
 }
 WORKSPACE = Path(__file__).resolve().parents[1]
 
@@ -43,3 +44,16 @@ def test_generated_interfaces_import():
         assert hasattr(msg, name), name
     for name in ['SetMode', 'SetPose', 'SetOperator']:
         assert hasattr(srv, name), name
+
+
+def test_tf2_msgs_is_there_with_jazzys_tfmessage():
+    """compat/tf2_msgs (built only without a ROS tf2_msgs) defines TFMessage as Jazzy."""
+    from rosbags.typesys import Stores, get_typestore
+    from tf2_msgs.msg import TFMessage
+    assert TFMessage.get_fields_and_field_types() == {
+        'transforms': 'sequence<geometry_msgs/TransformStamped>'}
+    jazzy, _ = get_typestore(Stores.ROS2_JAZZY).generate_msgdef('tf2_msgs/msg/TFMessage',
+                                                               ros_version=2)
+    compat = (WORKSPACE / 'compat/tf2_msgs/msg/TFMessage.msg').read_text()
+    assert jazzy.split('\n')[0] == compat.strip()
+    assert (WORKSPACE / 'compat/COLCON_IGNORE').is_file()

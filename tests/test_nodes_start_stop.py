@@ -6,7 +6,8 @@ from dukw_common.testing import NodeProcess, ros_node, spin_until
 NODES = [('dukw_driver', 'servo_switch_node'), ('dukw_driver', 'motor_controller_node'),
          ('dukw_driver', 'imu_gps_node'), ('dukw_driver', 'water_sensor_node'),
          ('dukw_estimation', 'ekf_node'), ('dukw_control', 'mode_manager_node'),
-         ('dukw_control', 'drive_controller_node'), ('dukw_sim', 'sim_node')]
+         ('dukw_control', 'drive_controller_node'), ('dukw_sim', 'sim_node'),
+         ('dukw_bringup', 'robot_state_node'), ('dukw_bringup', 'live_view_node')]
 
 
 @pytest.mark.ros

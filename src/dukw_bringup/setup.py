@@ -25,6 +25,8 @@ setup(
             # main job and bring-up (issue 7, bring-up helper)
             'bringup = dukw_bringup.bringup:main',
             'mission_node = dukw_bringup.mission_node:main',
+            'robot_state_node = dukw_bringup.robot_state_node:main',
+            'live_view_node = dukw_bringup.live_view_node:main',
             'main_job = dukw_bringup.main_job:main',
             'plot_run = dukw_bringup.plot_run:main',
             # rosbag2 tools (issue 7, bag helper)

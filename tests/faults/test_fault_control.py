@@ -13,10 +13,11 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from dukw_msgs.msg import (Authority, DiffCommand, DrivetrainStatus, DriveMode, Traction,
                            WaterContact)
 from dukw_msgs.srv import SetMode
-from geometry_msgs.msg import Twist
+from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu
 
+from dukw_common.cmd_vel import make_cmd_vel
 from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS
 from dukw_common.testing import NodeProcess, ros_node, spin_until
 
@@ -35,7 +36,7 @@ class Rig:
     def __init__(self, node, executor):
         self.node, self.executor = node, executor
         kinds = (('imu/data', Imu, SENSOR_QOS), ('odometry/filtered', Odometry, SENSOR_QOS),
-                 ('cmd_vel', Twist, COMMAND_QOS), ('water/contact', WaterContact, SENSOR_QOS),
+                 ('cmd_vel', TwistStamped, COMMAND_QOS), ('water/contact', WaterContact, SENSOR_QOS),
                  ('traction', Traction, SENSOR_QOS),
                  ('tracks/status', DrivetrainStatus, SENSOR_QOS),
                  ('authority', Authority, STATE_QOS))
@@ -75,9 +76,8 @@ class Rig:
             status.port.force_n = status.stbd.force_n = 200.0
             self.pubs['tracks/status'].publish(status)
         if self.on['cmd_vel']:
-            twist = Twist()
-            twist.linear.x = self.cmd
-            self.pubs['cmd_vel'].publish(twist)
+            now_s = self.node.get_clock().now().nanoseconds * 1e-9
+            self.pubs['cmd_vel'].publish(make_cmd_vel(True, self.cmd, 0.0, now_s))
 
     def spin(self, predicate, timeout_s=10.0):
         return spin_until(self.executor, predicate, timeout_s)

@@ -27,7 +27,7 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
 #: Topics the stack latches (transient local): a late subscriber gets the current value.
-LATCHED_TOPICS = ('authority', 'drive_mode')
+LATCHED_TOPICS = ('authority', 'drive_mode', 'tf_static', 'robot_description')
 #: Environment variable pointing at a folder of dukw_msgs ``*.msg`` files (overrides lookup).
 MSG_DIR_ENV = 'DUKW_MSGS_DIR'
 

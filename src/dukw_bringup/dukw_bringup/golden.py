@@ -12,8 +12,9 @@ replay uses (``replay_adapters``), fed with the messages as decoded from their C
 bytes, on the nodes' timer grids with fixed offsets inside each step:
 
     T        sensor messages of the step (stamped T), authority, cmd_vel (+0.1/0.2 ms)
+    0        robot_description and /tf_static (latched), as robot_state_node sends them
     T+0.5 ms the EKF's output on the IMU sample: odometry/filtered (the controller steps
-             on it: tracks/cmd, props/cmd at +0.5 us), traction (+1 us)
+             on it: tracks/cmd, props/cmd at +0.5 us), traction (+1 us), /tf (+2 us)
     T+1 ms   ekf timer tick (publishes only while the IMU is silent)
     T+2 ms   mode manager tick (every 5th step at 20 Hz): drive_mode on change or 1 s
     T+3 ms   controller timer tick (if it steps): tracks/cmd, props/cmd -> servo switch;
@@ -86,8 +87,10 @@ class _Loop:
                                                   ModeManagerAdapter)
         self.scenario = scenario
         self.writer = writer
+        self.config_path = config_path
         self.store = typestore()
         sim_params = node_params('sim_node', config_path)
+        self.cmd_vel_stamped = bool(sim_params['cmd_vel_stamped'])   # shared block
         self.sim = SimCore.from_config(config_path, seed=scenario.seed)
         self.sim.reset(x_m=scenario.start_x_m, yaw_rad=scenario.start_yaw_rad)
         self.sensors = SensorModel.from_config(config_path, seed=scenario.seed)
@@ -153,10 +156,12 @@ class _Loop:
                 traction_msg(est.traction(), stamp, Traction))
 
     def _publish_estimates(self, t_ns: int, messages: tuple) -> None:
-        """As ekf_node: odometry, then traction (1 us later, so the order is in the bag)."""
+        """As ekf_node: odometry, then traction and /tf (1 and 2 us later, in that order)."""
+        from dukw_common.tf_tools import odometry_tf
         everyone = (self.ekf, self.modes, self.controller)
         self._emit('odometry/filtered', t_ns, messages[0], everyone)
         self._emit('traction', t_ns + 1_000, messages[1], everyone)
+        self._emit('tf', t_ns + 2_000, odometry_tf(messages[0]))
 
     # --- one step --------------------------------------------------------------------
     def step(self, k: int) -> None:
@@ -164,7 +169,7 @@ class _Loop:
         from dukw_control.convert import decision_to_msg
         from dukw_sim import sim_messages as sm
         from dukw_sim.core import Actuation
-        from geometry_msgs.msg import Twist
+        from dukw_common.cmd_vel import make_cmd_vel
 
         t_prev_s = self.sim.t_s
         out = self.switch.outputs(t_prev_s)
@@ -184,9 +189,9 @@ class _Loop:
                        everyone)
         if k % 10 == 0:
             speed, yaw_rate = self.scenario.cmd_vel(t_ns * 1e-9)
-            twist = Twist()
-            twist.linear.x, twist.angular.z = float(speed), float(yaw_rate)
-            self._emit('cmd_vel', t_ns + MS_NS // 5, twist, everyone)
+            t_cmd_ns = t_ns + MS_NS // 5
+            self._emit('cmd_vel', t_cmd_ns, make_cmd_vel(self.cmd_vel_stamped, speed, yaw_rate,
+                                                         t_cmd_ns * 1e-9), everyone)
         if self.ekf_pending is not None:           # the EKF published on the IMU sample
             self._publish_estimates(t_ns + MS_NS // 2, self.ekf_pending)
             self.ekf_pending = None
@@ -213,7 +218,23 @@ class _Loop:
         if out is not None:
             self._command(t_ctrl, out)
 
+    def _describe(self) -> None:
+        """robot_description and /tf_static at t = 0, as robot_state_node."""
+        from dukw_common.config import node_params
+        from dukw_common.description import FrameNames, VehicleModel
+        from dukw_common.node_tools import s_to_stamp
+        from dukw_common.tf_tools import tf_message
+        from dukw_common.vehicle import Vehicle
+        from std_msgs.msg import String
+        params = node_params('robot_state_node', self.config_path)
+        vehicle = Vehicle.from_params(params)
+        model = VehicleModel.build(vehicle.body, vehicle.sensors, FrameNames.from_params(params),
+                                   float(params['deck_thickness_m']))
+        self._emit('robot_description', 0, String(data=model.urdf()))
+        self._emit('tf_static', 0, tf_message(model.static_transforms(), s_to_stamp(0.0)))
+
     def run(self) -> None:
+        self._describe()
         steps = round(self.scenario.duration_s * 1e9 / self.step_ns)
         for k in range(1, steps + 1):
             self.step(k)

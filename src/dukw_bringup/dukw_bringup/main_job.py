@@ -33,6 +33,8 @@ from dukw_bringup.run_setup import (MONITOR, SHORE_URL, default_run_dir, format_
 from dukw_bringup.summary import MODE_NAMES, summary_lines, write_summary
 from dukw_common.config import ConfigError, default_config_path
 
+#: The Foxglove layout for the live view and the run's bag.
+LAYOUT = 'config/foxglove/dukw_layout.json'
 EXIT_DONE, EXIT_FAILED, EXIT_CONFIG, EXIT_NOT_DONE, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 
 
@@ -55,6 +57,7 @@ class Monitor:
         self.speed_mps = math.nan
         self.track_a = (math.nan, math.nan)
         self.prop_a = (math.nan, math.nan)
+        self.live_view_url = ''
         self._subscribe()
 
     def _subscribe(self) -> None:
@@ -65,6 +68,7 @@ class Monitor:
         from dukw_common.node_tools import SENSOR_QOS, STATE_QOS
         node = self.node
         node.create_subscription(String, 'mission/status', self._on_status, STATE_QOS)
+        node.create_subscription(String, 'live_view/url', self._on_live_view, STATE_QOS)
         node.create_subscription(DriveMode, 'drive_mode', self._on_mode, STATE_QOS)
         node.create_subscription(Odometry, 'odometry/filtered', self._on_odom, SENSOR_QOS)
         node.create_subscription(DrivetrainStatus, 'tracks/status',
@@ -81,6 +85,12 @@ class Monitor:
             self.progress = Progress.from_json(msg.data)
         except ValueError as exc:
             self.node.get_logger().warn(str(exc), throttle_duration_sec=5.0)
+
+    def _on_live_view(self, msg) -> None:
+        if msg.data != self.live_view_url:
+            self.live_view_url = msg.data
+            print(f'[main_job] live view: {msg.data} (Foxglove: Open connection -> Foxglove '
+                  f'WebSocket; layout {LAYOUT})', flush=True)
 
     def _on_mode(self, msg) -> None:
         mode = MODE_NAMES.get(msg.mode, str(msg.mode))

@@ -1,7 +1,8 @@
 """mission_node: line-of-sight waypoint guidance on ``cmd_vel`` from ``odometry/filtered``.
 
 Subscribes ``odometry/filtered`` (nav_msgs/Odometry); publishes ``cmd_vel``
-(geometry_msgs/Twist, reliable) at ``rate_hz`` and ``mission/status``
+(geometry_msgs/TwistStamped stamped with the node's clock, or Twist:
+the shared ``cmd_vel_stamped``; reliable) at ``rate_hz`` and ``mission/status``
 (std_msgs/String, one JSON object of dukw_bringup.mission.Progress, latched)
 on every change of state or waypoint and at ``status_rate_hz``. The shore link
 (or anyone) may replace the waypoints with ``mission/plan`` (std_msgs/String,
@@ -17,7 +18,6 @@ from __future__ import annotations
 
 import math
 
-from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from rclpy.duration import Duration
 from rclpy.node import Node
@@ -25,6 +25,7 @@ from std_msgs.msg import Bool, String
 
 from dukw_bringup.mission import (LosGuidance, MissionState, VelocityCommand, load_mission,
                                   spec_with_plan)
+from dukw_common.cmd_vel import CMD_VEL_STAMPED_SPEC, cmd_vel_type, make_cmd_vel
 from dukw_common.config import ConfigError
 from dukw_common.geometry import euler_from_quaternion
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
@@ -43,14 +44,16 @@ class MissionNode(Node):
             ParamSpec('mission_file', "mission YAML; '' = config/mission.yaml"),
             ParamSpec('odometry_timeout_s', 'stop (zero cmd_vel) while odometry is older, s',
                       min=0.05, max=10.0),
+            CMD_VEL_STAMPED_SPEC,
         ])
+        self.stamped = bool(self.params['cmd_vel_stamped'])
         self.guidance = LosGuidance(load_mission(str(self.params['mission_file']) or None))
         self.pose: tuple[float, float, float] | None = None
         self.pose_time_s = -math.inf
         self.first_pose_s: float | None = None
         self.last_key: tuple = ()
         self.held = False
-        self.cmd_pub = self.create_publisher(Twist, 'cmd_vel', COMMAND_QOS)
+        self.cmd_pub = self.create_publisher(cmd_vel_type(self.stamped), 'cmd_vel', COMMAND_QOS)
         self.status_pub = self.create_publisher(String, 'mission/status', STATE_QOS)
         self.create_subscription(Odometry, 'odometry/filtered', self.on_odometry, SENSOR_QOS)
         self.create_subscription(String, 'mission/plan', self.on_plan, STATE_QOS)
@@ -127,10 +130,8 @@ class MissionNode(Node):
 
     def publish_command(self, command: VelocityCommand) -> None:
         """Send one cmd_vel."""
-        twist = Twist()
-        twist.linear.x = float(command.speed_mps)
-        twist.angular.z = float(command.yaw_rate_rps)
-        self.cmd_pub.publish(twist)
+        self.cmd_pub.publish(make_cmd_vel(self.stamped, command.speed_mps,
+                                          command.yaw_rate_rps, self.now_s()))
 
     def publish_status(self) -> None:
         """Send the progress as JSON."""

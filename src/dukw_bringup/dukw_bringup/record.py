@@ -90,13 +90,7 @@ class Recorder:
             self._subscribe(topic, msgtype, [p.qos_profile for p in publishers])
 
     def _subscribe(self, topic: str, msgtype: str, offered: list[QoSProfile]) -> None:
-        reliable = all(q.reliability == ReliabilityPolicy.RELIABLE for q in offered)
-        latched = all(q.durability == DurabilityPolicy.TRANSIENT_LOCAL for q in offered)
-        qos = QoSProfile(
-            history=HistoryPolicy.KEEP_LAST, depth=RECORD_DEPTH,
-            reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
-            durability=(DurabilityPolicy.TRANSIENT_LOCAL if latched
-                        else DurabilityPolicy.VOLATILE))
+        qos = matching_qos(offered, RECORD_DEPTH)
         self.writer.add_topic(topic, msgtype, [offered_qos(q) for q in offered])
         cls = message_class(msgtype)
         self._subscriptions[topic] = self.node.create_subscription(
@@ -131,6 +125,17 @@ def offered_qos(profile: QoSProfile) -> Qos:
                liveliness=QosLiveliness(int(profile.liveliness)),
                liveliness_lease_duration=span(profile.liveliness_lease_duration),
                avoid_ros_namespace_conventions=bool(profile.avoid_ros_namespace_conventions))
+
+
+def matching_qos(offered: list[QoSProfile], depth: int) -> QoSProfile:
+    """A subscription that matches every publisher: reliable only if all are, transient
+    local when all are (so latched values arrive)."""
+    reliable = all(q.reliability == ReliabilityPolicy.RELIABLE for q in offered)
+    latched = all(q.durability == DurabilityPolicy.TRANSIENT_LOCAL for q in offered)
+    return QoSProfile(
+        history=HistoryPolicy.KEEP_LAST, depth=depth,
+        reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
+        durability=DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE)
 
 
 def message_class(msgtype: str):

@@ -111,20 +111,23 @@ class DriveControllerAdapter(CoreAdapter):
     outputs = ('tracks/cmd', 'props/cmd')
 
     def __init__(self, config_path: str | None = None) -> None:
+        from dukw_common.cmd_vel import read_cmd_vel
         from dukw_control import convert
         from dukw_control.controller import DriveController, settings_from_params
         params = _node_params('drive_controller_node', config_path)
         self.rate_hz = float(params['rate_hz'])
         self.core = DriveController(settings_from_params(params))
         self.convert = convert
+        self.read_cmd_vel = read_cmd_vel
         self.step_on_odometry = bool(params.get('step_on_odometry', False))
         self.pitch_from_odometry = hasattr(convert, 'pitch_from_quaternion')
         self.last_event_step_s = -1.0
 
     def feed(self, topic, t_s, msg):
         core = self.core
-        if topic == 'cmd_vel':
-            core.on_cmd_vel(msg.linear.x, msg.angular.z, t_s)
+        if topic == 'cmd_vel':          # Twist or TwistStamped, whichever the bag holds
+            speed_mps, yaw_rate_rps, stamp_s = self.read_cmd_vel(msg)
+            core.on_cmd_vel(speed_mps, yaw_rate_rps, t_s, stamp_s)
         elif topic == 'authority':
             usable, detail = self.convert.authority_usable(msg)
             core.on_authority(usable, detail, t_s)

@@ -38,6 +38,7 @@ SHORE_URL = 'udpout:127.0.0.1:14550'
 ShoreSetup = tuple[Path, str]      # the shore link's signing key file and url
 RECORDER = 'recorder'
 MONITOR = 'main_job'
+LIVE_VIEW = 'live_view_node'
 
 
 def default_run_dir(root: Path, now: dt.datetime | None = None) -> Path:
@@ -85,6 +86,9 @@ def write_overlay(path: Path, stack: StackSpec, spec: MissionSpec, mission_file:
             doc[name] = {'ros__parameters': sim_overrides(spec, real_time_factor)}
         else:
             doc[name] = {'ros__parameters': {'use_sim_time': True}}
+    if LIVE_VIEW in doc:                # draws the same sea as the simulator
+        sea = sim_overrides(spec, real_time_factor)
+        doc[LIVE_VIEW]['ros__parameters'].update(seed=sea['seed'], waves=sea['waves'])
     if 'mission_node' in doc:
         doc['mission_node']['ros__parameters']['mission_file'] = str(mission_file)
     if SHORE_NODE in doc:

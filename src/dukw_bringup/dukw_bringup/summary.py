@@ -32,6 +32,10 @@ def _sides(prefix: str, field_name: str) -> dict[str, Getter]:
             f'stbd_{prefix}': lambda m: getattr(m.stbd, field_name)}
 
 
+def _twist(msg):
+    return getattr(msg, 'twist', msg)
+
+
 #: topic -> column -> how to read it from the deserialized message.
 COLUMNS: dict[str, dict[str, Getter]] = {
     'odometry/filtered': {
@@ -51,7 +55,8 @@ COLUMNS: dict[str, dict[str, Getter]] = {
     'drive_mode': {'mode': lambda m: m.mode},
     'tracks/cmd': {'port_pct': lambda m: m.port_pct, 'stbd_pct': lambda m: m.stbd_pct},
     'props/cmd': {'port_pct': lambda m: m.port_pct, 'stbd_pct': lambda m: m.stbd_pct},
-    'cmd_vel': {'speed_mps': lambda m: m.linear.x, 'yaw_rate_rps': lambda m: m.angular.z},
+    'cmd_vel': {'speed_mps': lambda m: _twist(m).linear.x,       # Twist or TwistStamped
+                'yaw_rate_rps': lambda m: _twist(m).angular.z},
 }
 #: topics kept as text (time, text)
 TEXT_TOPICS = {'mission/status': lambda m: m.data, 'drive_mode': lambda m: m.reason}

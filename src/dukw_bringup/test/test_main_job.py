@@ -101,7 +101,9 @@ def test_short_main_job_leaves_bag_summary_and_plots(tmp_path):
     topics = set(summary['bag_topics'])
     assert {'/clock', '/sim/truth', '/imu/data', '/odometry/filtered', '/cmd_vel',
             '/tracks/cmd', '/tracks/status', '/traction', '/drive_mode',
-            '/mission/status'} <= topics
+            '/mission/status', '/tf', '/tf_static', '/robot_description',
+            '/live_view/beach'} <= topics
+    assert '[main_job] live view: ws://127.0.0.1:' in stdout
     assert summary['track_currents']['port']['peak_a'] > 0.0
 
 

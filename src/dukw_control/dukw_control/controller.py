@@ -226,19 +226,36 @@ class DriveController:
         self.output = ControlOutput(neutral_reason='starting')
 
     # --- inputs -----------------------------------------------------------------------
-    def on_cmd_vel(self, speed_mps: float, yaw_rate_rps: float, now_s: float) -> bool:
-        """A velocity request; False (and counted, nothing changed) if rejected."""
+    def on_cmd_vel(self, speed_mps: float, yaw_rate_rps: float, now_s: float,
+                   stamp_s: float | None = None) -> bool:
+        """A velocity request; False (and counted, nothing changed) if rejected.
+
+        ``stamp_s`` (a TwistStamped's header, on ``now_s``'s clock): the request's age
+        counts from its stamp (a stamp ahead of ``now_s`` counts as now), and one already
+        ``cmd_timeout_s`` old is refused as timed out: it never refreshes the command.
+        """
         try:
             validate_twist(speed_mps, yaw_rate_rps, self.s.max_speed_mps,
                            self.s.max_yaw_rate_rps)
+            sent_s = now_s if stamp_s is None else self._sent_time(stamp_s, now_s)
         except ValueError as exc:
             self.i.rejected += 1
             self.i.last_rejection = str(exc)
             return False
         if self.stuck.stuck and (speed_mps == 0.0 or speed_mps * self.i.cmd[0] < 0.0):
             self.stuck.clear()
-        self.i.cmd, self.i.cmd_s = (float(speed_mps), float(yaw_rate_rps)), now_s
+        self.i.cmd, self.i.cmd_s = (float(speed_mps), float(yaw_rate_rps)), sent_s
         return True
+
+    def _sent_time(self, stamp_s: float, now_s: float) -> float:
+        """When a stamped request was sent; ValueError when it is already timed out."""
+        if not math.isfinite(stamp_s):
+            raise ValueError(f'cmd_vel stamp {stamp_s} is not finite')
+        age_s = now_s - stamp_s
+        if age_s >= self.s.cmd_timeout_s:
+            raise ValueError(f'cmd_vel stamped {age_s:.3f} s ago: older than cmd_timeout_s '
+                             f'({self.s.cmd_timeout_s} s), treated as timed out')
+        return min(stamp_s, now_s)
 
     def on_authority(self, usable: bool, detail: str, now_s: float) -> None:
         """Whether the computer holds authority with live outputs (RC operator: False)."""

@@ -5,11 +5,11 @@ runs the core at ``rate_hz`` and publishes the commands (neutral on shutdown).
 """
 from diagnostic_msgs.msg import DiagnosticArray
 from dukw_msgs.msg import Authority, DrivetrainStatus, DriveMode, Traction
-from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from sensor_msgs.msg import Imu
 
+from dukw_common.cmd_vel import CMD_VEL_STAMPED_SPEC, cmd_vel_type, read_cmd_vel
 from dukw_common.config import ConfigError
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
                                     declare_parameters, diagnostic_array, publisher_sources,
@@ -26,6 +26,7 @@ class DriveControllerNode(Node):
         super().__init__('drive_controller_node')
         specs = [ParamSpec(n, d, min=lo, max=hi) for n, d, lo, hi in NODE_PARAMS]
         specs.append(ParamSpec('step_on_odometry', 'run a control step on each estimate'))
+        specs.append(CMD_VEL_STAMPED_SPEC)
         params = declare_parameters(self, specs + vehicle_specs('vehicle', 'drivetrain',
                                                                 'limits'))
         try:
@@ -34,7 +35,8 @@ class DriveControllerNode(Node):
             raise ConfigError(f'drive_controller_node: {exc}') from exc
         self.commands = ActuatorPublishers(self, COMMAND_QOS)
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
-        self.create_subscription(Twist, 'cmd_vel', self.on_cmd_vel, COMMAND_QOS)
+        self.create_subscription(cmd_vel_type(params['cmd_vel_stamped']), 'cmd_vel',
+                                 self.on_cmd_vel, COMMAND_QOS)
         self.create_subscription(Authority, 'authority', self.on_authority, STATE_QOS)
         self.create_subscription(DriveMode, 'drive_mode', self.on_mode, STATE_QOS)
         self.create_subscription(Odometry, 'odometry/filtered', self.on_odometry, SENSOR_QOS)
@@ -54,8 +56,10 @@ class DriveControllerNode(Node):
         """Node clock (sim time under use_sim_time), seconds."""
         return self.get_clock().now().nanoseconds * 1e-9
 
-    def on_cmd_vel(self, msg: Twist) -> None:
-        if not self.core.on_cmd_vel(msg.linear.x, msg.angular.z, self.now_s()):
+    def on_cmd_vel(self, msg) -> None:
+        """geometry_msgs/TwistStamped (its stamp ages it) or Twist, as cmd_vel_stamped says."""
+        speed_mps, yaw_rate_rps, stamp_s = read_cmd_vel(msg)
+        if not self.core.on_cmd_vel(speed_mps, yaw_rate_rps, self.now_s(), stamp_s):
             self.get_logger().warn(f'cmd_vel rejected: {self.core.i.last_rejection}',
                                    throttle_duration_sec=1.0)
 

@@ -96,6 +96,31 @@ def test_losing_cmd_vel_fades_to_neutral_by_the_timeout(controller_settings):
         controller_settings.timeout_ramp_s
 
 
+def test_a_stamp_ages_the_request_and_a_stale_stamp_counts_as_a_timeout(controller_settings):
+    r = Rig(controller_settings)
+    timeout_s = controller_settings.cmd_timeout_s
+    r.run(2.0)
+    sent_t = r.t - 0.3
+    assert r.c.on_cmd_vel(1.0, 0.0, r.t, stamp_s=sent_t)            # 0.3 s in transit
+    neutral_at = next(r.t for _ in range(100) if r.run(DT, send_cmd=False).tracks.is_neutral())
+    assert timeout_s - DT < neutral_at - sent_t <= timeout_s + 1e-9  # aged from the stamp
+    # a request stamped cmd_timeout_s ago is refused: it does not refresh the command
+    r = Rig(controller_settings)
+    r.run(2.0)
+    last_fresh_t = r.t
+    for _ in range(100):
+        r.t += DT
+        assert not r.c.on_cmd_vel(1.0, 0.0, r.t, stamp_s=r.t - timeout_s)
+        r.c.on_track_currents(20.0, 20.0, r.t)
+        r.c.on_pitch(0.0, r.t)
+        out = r.c.step(r.t)
+    assert out.neutral_reason == 'cmd_vel timed out' and r.t - last_fresh_t >= timeout_s
+    assert 'treated as timed out' in r.c.i.last_rejection
+    assert not r.c.on_cmd_vel(1.0, 0.0, r.t, stamp_s=math.nan)
+    # a stamp ahead of the controller's clock counts as now, not as a longer life
+    assert r.c.on_cmd_vel(1.0, 0.0, r.t, stamp_s=r.t + 5.0) and r.c.i.cmd_s == r.t
+
+
 def test_bad_requests_are_rejected_and_the_previous_one_stands(controller_settings):
     r = Rig(controller_settings)
     before = r.run(2.0)

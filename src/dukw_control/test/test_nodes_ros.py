@@ -5,10 +5,10 @@ import pytest
 from dukw_msgs.msg import Authority, DiffCommand, DrivetrainStatus, DriveMode, Traction
 from dukw_msgs.msg import WaterContact
 from dukw_msgs.srv import SetMode
-from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu
 
+from dukw_common.cmd_vel import cmd_vel_type, make_cmd_vel
 from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS, stamp_to_s
 from dukw_common.testing import NodeProcess, ros_node, spin_until
 
@@ -38,11 +38,13 @@ def imu_now(node):
 class Probe:
     """Publishes the controller's inputs and records tracks/cmd."""
 
-    def __init__(self, node):
+    def __init__(self, node, stamped=True, stamp_age_s=0.0):
         self.node = node
+        self.stamped, self.stamp_age_s = stamped, stamp_age_s
         self.pubs = {name: node.create_publisher(kind, name, qos) for name, kind, qos in (
             ('authority', Authority, STATE_QOS), ('drive_mode', DriveMode, STATE_QOS),
-            ('cmd_vel', Twist, COMMAND_QOS), ('odometry/filtered', Odometry, SENSOR_QOS),
+            ('cmd_vel', cmd_vel_type(stamped), COMMAND_QOS),
+            ('odometry/filtered', Odometry, SENSOR_QOS),
             ('tracks/status', DrivetrainStatus, SENSOR_QOS), ('imu/data', Imu, SENSOR_QOS))}
         self.tracks = []
         node.create_subscription(DiffCommand, 'tracks/cmd', self.tracks.append, COMMAND_QOS)
@@ -60,22 +62,27 @@ class Probe:
         self.pubs['tracks/status'].publish(tracks_status())
         self.pubs['imu/data'].publish(imu_now(self.node))
         if self.sending_cmd:
-            twist = Twist()
-            twist.linear.x = 1.0
-            self.pubs['cmd_vel'].publish(twist)
             self.last_cmd_s = self.now_s()
+            self.pubs['cmd_vel'].publish(make_cmd_vel(self.stamped, 1.0, 0.0,
+                                                      self.last_cmd_s - self.stamp_age_s))
 
     def moving(self):
         return bool(self.tracks) and self.tracks[-1].stbd_pct > 10.0
 
 
-def test_drive_controller_drives_then_goes_neutral_on_takeover_and_on_cmd_vel_loss():
+def start_driving(probe):
+    mode = DriveMode(mode=DriveMode.LAND, automatic=True, track_weight=1.0, reason='test')
+    probe.pubs['drive_mode'].publish(mode)
+    probe.pubs['authority'].publish(authority(Authority.HOLDER_COMPUTER))
+
+
+@pytest.mark.parametrize('stamped', [True, False], ids=['TwistStamped', 'Twist'])
+def test_drive_controller_drives_then_goes_neutral_on_takeover_and_on_cmd_vel_loss(stamped):
     with ros_node('control_probe') as (node, executor):
-        probe = Probe(node)
-        mode = DriveMode(mode=DriveMode.LAND, automatic=True, track_weight=1.0, reason='test')
-        probe.pubs['drive_mode'].publish(mode)
-        probe.pubs['authority'].publish(authority(Authority.HOLDER_COMPUTER))
-        with NodeProcess('dukw_control', 'drive_controller_node') as proc:
+        probe = Probe(node, stamped)
+        start_driving(probe)
+        args = ['--ros-args', '-p', f'cmd_vel_stamped:={str(stamped).lower()}']
+        with NodeProcess('dukw_control', 'drive_controller_node', args) as proc:
             assert spin_until(executor, probe.moving, 30.0), proc.stderr
             assert probe.tracks[-1].port_pct > probe.tracks[-1].stbd_pct   # port bias
             # the RC operator takes over: neutral, and it stays neutral until a fresh cmd_vel
@@ -98,6 +105,19 @@ def test_drive_controller_drives_then_goes_neutral_on_takeover_and_on_cmd_vel_lo
         assert proc.proc.returncode == 0, proc.stderr
         spin_until(executor, lambda: len(probe.tracks) > count, 2.0)
         assert probe.tracks[-1].port_pct == 0.0 and probe.tracks[-1].stbd_pct == 0.0
+
+
+def test_drive_controller_treats_a_stale_twist_stamped_as_timed_out():
+    with ros_node('control_probe') as (node, executor):
+        probe = Probe(node, stamped=True, stamp_age_s=0.6)     # cmd_timeout_s is 0.5 s
+        start_driving(probe)
+        with NodeProcess('dukw_control', 'drive_controller_node') as proc:
+            assert spin_until(executor, lambda: len(probe.tracks) > 20, 30.0), proc.stderr
+            spin_until(executor, lambda: False, 1.0)
+            assert not any(m.stbd_pct != 0.0 for m in probe.tracks)
+            probe.stamp_age_s = 0.1                             # fresh enough: it drives
+            assert spin_until(executor, probe.moving, 10.0)
+        assert 'treated as timed out' in proc.stderr
 
 
 def test_mode_manager_publishes_land_and_obeys_set_mode():

@@ -1,13 +1,14 @@
 """The whole stack on the simulator: sim_node, ekf_node and the two control nodes as
-processes drive the vehicle from the sand into the sea on a cmd_vel of 1 m/s."""
+processes drive the vehicle from the sand into the sea on a cmd_vel of 1 m/s, sent as
+Jazzy's geometry_msgs/TwistStamped stamped with the simulator's time."""
 import itertools
 import time
 
 import pytest
 from dukw_msgs.msg import DriveMode, SimTruth
-from geometry_msgs.msg import Twist
 
-from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS
+from dukw_common.cmd_vel import cmd_vel_type, make_cmd_vel
+from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS, stamp_to_s
 from dukw_common.testing import NodeProcess, ros_node
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
@@ -24,10 +25,13 @@ def test_sand_to_sea_on_a_cmd_vel_of_1_mps():
         truths, modes = [], []
         node.create_subscription(SimTruth, 'sim/truth', truths.append, SENSOR_QOS)
         node.create_subscription(DriveMode, 'drive_mode', modes.append, STATE_QOS)
-        cmd_vel = node.create_publisher(Twist, 'cmd_vel', COMMAND_QOS)
-        request = Twist()
-        request.linear.x = 1.0
-        node.create_timer(0.05, lambda: cmd_vel.publish(request))
+        cmd_vel = node.create_publisher(cmd_vel_type(True), 'cmd_vel', COMMAND_QOS)
+
+        def request():                 # stamped with the latest sim time seen
+            if truths:
+                sim_s = stamp_to_s(truths[-1].header.stamp)
+                cmd_vel.publish(make_cmd_vel(True, 1.0, 0.0, sim_s))
+        node.create_timer(0.05, request)
         procs = [NodeProcess('dukw_sim', 'sim_node', ['--ros-args', '-p', 'real_time_factor:=1.0',
                                                       '-p', 'waves.model:=irregular']),
                  NodeProcess('dukw_estimation', 'ekf_node', SIM_TIME),

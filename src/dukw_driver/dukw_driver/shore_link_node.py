@@ -13,12 +13,12 @@ from pathlib import Path
 from diagnostic_msgs.msg import DiagnosticArray
 from dukw_msgs.msg import Authority, DriveMode, DrivetrainStatus, Traction
 from dukw_msgs.srv import SetMode
-from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from sensor_msgs.msg import Imu, NavSatFix
 from std_msgs.msg import Bool, String
 
+from dukw_common.cmd_vel import CMD_VEL_STAMPED_SPEC, cmd_vel_type, make_cmd_vel
 from dukw_common.config import ConfigError
 from dukw_common.diagnostics import Level
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, declare_parameters,
@@ -35,7 +35,7 @@ class ShoreLinkNode(Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__('shore_link_node', **kwargs)
-        p = declare_parameters(self, conv.PARAMS)
+        p = declare_parameters(self, [*conv.PARAMS, CMD_VEL_STAMPED_SPEC])
         settings, tuning = settings_from_params(p)
         self.store, signing = TimestampStore(None), None
         if p['signing']:
@@ -49,7 +49,8 @@ class ShoreLinkNode(Node):
         self.port = MavlinkPort(p['url'], settings.radio_baud, p['reconnect_period_s'])
         self.core = ShoreLink(settings, tuning, signing, time.monotonic())
         self.last = (time.monotonic(), 0, 0)
-        self.cmd_pub = self.create_publisher(Twist, 'cmd_vel', COMMAND_QOS)
+        self.stamped = bool(p['cmd_vel_stamped'])
+        self.cmd_pub = self.create_publisher(cmd_vel_type(self.stamped), 'cmd_vel', COMMAND_QOS)
         self.plan_pub = self.create_publisher(String, 'mission/plan', STATE_QOS)
         self.hold_pub = self.create_publisher(Bool, 'mission/hold', STATE_QOS)
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
@@ -94,9 +95,9 @@ class ShoreLinkNode(Node):
         actions = self.core.receive(self.port.poll(), now) + self.core.tick(now)
         for action in actions:
             if isinstance(action, DriveCommand):
-                twist = Twist()
-                twist.linear.x, twist.angular.z = action.speed_mps, action.yaw_rate_rps
-                self.cmd_pub.publish(twist)
+                stamp_s = self.get_clock().now().nanoseconds * 1e-9
+                self.cmd_pub.publish(make_cmd_vel(self.stamped, action.speed_mps,
+                                                  action.yaw_rate_rps, stamp_s))
             elif isinstance(action, MissionHold):
                 self.hold_pub.publish(Bool(data=action.hold))
             elif isinstance(action, MissionPlan):

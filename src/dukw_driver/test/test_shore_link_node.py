@@ -5,7 +5,7 @@ import time
 
 import pytest
 from dukw_msgs.srv import SetMode
-from geometry_msgs.msg import Twist
+from geometry_msgs.msg import TwistStamped
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from nav_msgs.msg import Odometry
@@ -42,7 +42,7 @@ class UdpGraph(NodeGraph):
         port = self.gcs.port.getsockname()[1]
         super().__init__(probe, executor, ShoreLinkNode, url=f'udpout:127.0.0.1:{port}',
                          signing_key_file=str(key_file), **overrides)
-        self.cmd = self.record(Twist, 'cmd_vel', qos=COMMAND_QOS)
+        self.cmd = self.record(TwistStamped, 'cmd_vel', qos=COMMAND_QOS)
         self.plans = self.record(String, 'mission/plan', qos=STATE_QOS)
         self.holds = self.record(Bool, 'mission/hold', qos=STATE_QOS)
         self.odom_pub = probe.create_publisher(Odometry, 'odometry/filtered', SENSOR_QOS)
@@ -104,11 +104,12 @@ def test_manual_control_drives_cmd_vel_and_its_loss_stops_it(graph):
         if len(sent) < 20:
             graph.gcs.mav.manual_control_send(1, 600, 0, 500, 0, 0)
             sent.append(time.monotonic())
-    assert graph.pump(10.0, lambda: any(abs(c.linear.x - 0.6) < 1e-9 for c in graph.cmd),
+    assert graph.pump(10.0, lambda: any(abs(c.twist.linear.x - 0.6) < 1e-9
+                                        for c in graph.cmd),
                       manual)
     graph.pump(10.0, lambda: len(sent) >= 20, manual)
     last_s = sent[-1]
-    assert graph.pump(2.0, lambda: graph.cmd[-1].linear.x == 0.0)
+    assert graph.pump(2.0, lambda: graph.cmd[-1].twist.linear.x == 0.0)
     stop_after_s = time.monotonic() - last_s
     assert stop_after_s < 0.5 + 0.1, stop_after_s                 # 0.1 s: this loop's polling
     assert graph.holds and graph.holds[0].data is True            # a running mission is held
@@ -124,10 +125,10 @@ def test_strangers_and_replays_are_rejected_without_locking_out_the_key(graph):
     for packet in (stranger.manual(1000), unsigned.manual(1000), good, good):
         graph.gcs.write(packet)
         graph.pump(0.2)
-    assert [round(c.linear.x, 3) for c in graph.cmd if c.linear.x] == [0.4]
+    assert [round(c.twist.linear.x, 3) for c in graph.cmd if c.twist.linear.x] == [0.4]
     graph.cmd.clear()
     graph.gcs.write(real.manual(300))                              # the real key still works
-    assert graph.pump(3.0, lambda: any(abs(c.linear.x - 0.3) < 1e-9 for c in graph.cmd))
+    assert graph.pump(3.0, lambda: any(abs(c.twist.linear.x - 0.3) < 1e-9 for c in graph.cmd))
     assert graph.pump(5.0, lambda: graph.value('shore link', 'rejected_replayed') == '1')
     assert graph.value('shore link', 'rejected_bad_signature') == '1'
     assert graph.value('shore link', 'rejected_unsigned') == '1'
@@ -191,7 +192,7 @@ def test_installed_node_over_a_pty_radio_keeps_its_timestamps(tmp_path, key_file
     os.set_blocking(master, False)
     with ros_node('probe_shore_pty') as (probe, executor):
         cmds = []
-        probe.create_subscription(Twist, 'cmd_vel', cmds.append, COMMAND_QOS)
+        probe.create_subscription(TwistStamped, 'cmd_vel', cmds.append, COMMAND_QOS)
         proc = NodeProcess('dukw_driver', 'shore_link_node', args)
         try:
             def read_radio():
@@ -207,9 +208,10 @@ def test_installed_node_over_a_pty_radio_keeps_its_timestamps(tmp_path, key_file
             def joystick():                    # sticks at 0.7 while the radio is read
                 os.write(master, gcs.manual(700))
                 read_radio()
-                return any(c.linear.x == 0.7 for c in cmds)
+                return any(c.twist.linear.x == 0.7 for c in cmds)
             assert spin_until(executor, joystick, 15.0)
-            assert spin_until(executor, lambda: read_radio() and cmds[-1].linear.x == 0.0, 2.0)
+            assert spin_until(executor,
+                              lambda: read_radio() and cmds[-1].twist.linear.x == 0.0, 2.0)
         finally:
             code = proc.stop()
             os.close(master)

@@ -1,7 +1,8 @@
 """ekf_node: fuses IMU, DGPS, water contact, depth and motor status into odometry and traction.
 
 Subscribes (sensor QoS) imu/data, gps/fix, gps/vel, water/contact, depth, tracks/status,
-props/status; publishes odometry/filtered (odom -> base_link), traction and /diagnostics;
+props/status; publishes odometry/filtered (odom -> base_link; also on /tf with
+``publish_tf``, as robot_localization), traction and /diagnostics;
 serves set_pose (dukw_msgs/srv/SetPose). All the work is in dukw_estimation.estimator.
 """
 from __future__ import annotations
@@ -13,10 +14,12 @@ from geometry_msgs.msg import TwistWithCovarianceStamped
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from sensor_msgs.msg import Imu, NavSatFix
+from tf2_msgs.msg import TFMessage
 
 from dukw_common.config import node_params, section
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, ParamSpec, declare_parameters,
                                     diagnostic_array, run_node, s_to_stamp, vehicle_specs)
+from dukw_common.tf_tools import TF_QOS, odometry_tf
 from dukw_common.vehicle import Vehicle, soil_params
 from dukw_estimation import ros_convert as conv
 from dukw_estimation.estimator import Estimator
@@ -34,6 +37,7 @@ class EkfNode(Node):
         specs += vehicle_specs()
         specs.append(ParamSpec('publish_on_imu', 'publish after each IMU sample, not only on '
                                'the timer'))
+        specs.append(ParamSpec('publish_tf', 'broadcast odom -> base_link on /tf'))
         specs += [ParamSpec(f'soil_presets.{name}', 'soil preset value (vehicle.md 6)', min=0.0)
                   for name in section(node_params('ekf_node'), 'soil_presets')
                   if name != 'names']
@@ -46,6 +50,8 @@ class EkfNode(Node):
         self.odom_pub = self.create_publisher(Odometry, 'odometry/filtered', COMMAND_QOS)
         self.traction_pub = self.create_publisher(Traction, 'traction', COMMAND_QOS)
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
+        self.tf_pub = (self.create_publisher(TFMessage, '/tf', TF_QOS)
+                       if params['publish_tf'] else None)
         est = self.estimator
         for msg_type, topic, convert, add in (
                 (Imu, 'imu/data', conv.imu_sample, est.add_imu),
@@ -87,7 +93,10 @@ class EkfNode(Node):
     def _publish(self) -> None:
         est = self.estimator
         stamp = s_to_stamp(est.t_s)
-        self.odom_pub.publish(conv.odometry_msg(est.odometry(), stamp, 'odom', 'base_link'))
+        odom = conv.odometry_msg(est.odometry(), stamp, 'odom', 'base_link')
+        self.odom_pub.publish(odom)
+        if self.tf_pub is not None:
+            self.tf_pub.publish(odometry_tf(odom))
         self.traction_pub.publish(conv.traction_msg(est.traction(), stamp, Traction))
 
     def _on_diagnostics(self) -> None:

@@ -8,11 +8,13 @@ from dukw_msgs.srv import SetPose
 from geometry_msgs.msg import TwistWithCovarianceStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu, NavSatFix
+from tf2_msgs.msg import TFMessage
 
 from dukw_common.config import node_params
 from dukw_common.geometry import geodetic_from_local_enu, quaternion_from_euler
 from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS
 from dukw_common.testing import ros_node, spin_until
+from dukw_common.tf_tools import TF_QOS
 from dukw_estimation.ekf_node import EkfNode
 
 pytestmark = pytest.mark.ros
@@ -139,3 +141,21 @@ def test_set_pose_service_moves_the_estimate(harness):
     odom = harness.odom[-1].pose.pose
     assert (odom.position.x, odom.position.y) == pytest.approx((20.0, -3.0), abs=0.01)
     assert 2 * math.atan2(odom.orientation.z, odom.orientation.w) == pytest.approx(1.0)
+
+
+def test_odom_to_base_link_goes_on_tf_with_each_estimate(harness):
+    tfs = []
+    harness.probe.create_subscription(TFMessage, '/tf', tfs.append, TF_QOS)
+    assert harness.run_until(lambda: _near_start(harness) and len(tfs) > 5)
+    by_stamp = {(o.header.stamp.sec, o.header.stamp.nanosec): o for o in harness.odom}
+    checked = 0
+    for message in tfs:
+        (tf,) = message.transforms
+        assert (tf.header.frame_id, tf.child_frame_id) == ('odom', 'base_link')
+        odom = by_stamp.get((tf.header.stamp.sec, tf.header.stamp.nanosec))
+        if odom is not None:
+            assert tf.transform.translation.x == odom.pose.pose.position.x
+            assert tf.transform.translation.y == odom.pose.pose.position.y
+            assert tf.transform.rotation == odom.pose.pose.orientation
+            checked += 1
+    assert checked > 0

@@ -8,11 +8,14 @@ import time
 from dukw_msgs.msg import DiffCommand
 from dukw_msgs.srv import SetOperator
 from rclpy.node import Node
+from tf2_msgs.msg import TFMessage
 
 from dukw_common.config import ConfigError
+from dukw_common.description import pose_transform
 from dukw_common.diagnostics import Level
 from dukw_common.node_tools import (COMMAND_QOS, declare_parameters, diagnostic_array,
-                                    publisher_sources, run_node)
+                                    publisher_sources, run_node, s_to_stamp)
+from dukw_common.tf_tools import TF_QOS, tf_message
 from dukw_driver.authority import CommandGate
 from dukw_sim.core import Actuation, SimCore
 from dukw_sim.runtime import Pacer, SpeedMeter, sim_healths
@@ -40,6 +43,8 @@ class SimNode(Node):
         self.pubs = {topic: self.create_publisher(kind, topic, qos)
                      for topic, kind, qos in TOPICS}
         self.counts = {topic: 0 for topic in self.pubs}
+        self.truth_tf_pub = (self.create_publisher(TFMessage, '/tf', TF_QOS)
+                             if p['frames.truth'] else None)
         for actuator in CommandGate.ACTUATORS:
             self.create_subscription(DiffCommand, f'{actuator}/cmd',
                                      lambda msg, a=actuator: self.on_command(a, msg), COMMAND_QOS)
@@ -101,6 +106,7 @@ class SimNode(Node):
             self.publish('/clock', self.msgs.clock(t))
         if 'truth' in due:
             self.publish('sim/truth', self.msgs.sim_truth(self.truth))
+            self.publish_truth_tf()
         if 'rc' in due:
             self.publish('rc/input', self.msgs.rc_input(self.switch.rc_reading(t)))
         if self.switch.gate.changed or 'authority' in due:
@@ -108,6 +114,14 @@ class SimNode(Node):
             self.publish('authority', self.msgs.authority(self.switch.state, t))
         if 'diagnostics' in due:
             self.publish('/diagnostics', self.diagnostics())
+
+    def publish_truth_tf(self) -> None:
+        """odom -> frames.truth: the true pose beside the estimate's odom -> base_link."""
+        if self.truth_tf_pub is not None:
+            t = self.truth
+            pose = pose_transform(self.msgs.frames.odom, self.params['frames.truth'], t.x_m,
+                                  t.y_m, t.z_m, t.roll_rad, t.pitch_rad, t.yaw_rad)
+            self.truth_tf_pub.publish(tf_message([pose], s_to_stamp(t.t_s)))
 
     def diagnostics(self):
         """Simulator speed, authority, and every topic's rate (Hz of sim time)."""

@@ -34,6 +34,7 @@ _OWN = [
     ParamSpec('frames.base', 'frame_id of the vehicle (base_link)'),
     ParamSpec('frames.imu', 'frame_id of imu/data: (0, 0, sensors.imu_z_m) in base_link'),
     ParamSpec('frames.gps', 'frame_id of gps/fix and gps/vel: (0, 0, sensors.gps_antenna_z_m)'),
+    ParamSpec('frames.truth', "the true pose's frame: odom -> it on /tf ('' = none)"),
     *[ParamSpec(f'rates.{s}_hz', f'{s} publication rate, Hz of sim time', min=0.01, max=1000.0)
       for s in (*SENSOR_STREAMS, *NODE_STREAMS)],
     *[ParamSpec(f'noise.{n}', f'sensor noise: {n}', min=0.0)

@@ -6,9 +6,11 @@ from diagnostic_msgs.msg import DiagnosticArray
 from dukw_msgs.msg import Authority, Depth, DiffCommand, DrivetrainStatus, RcInput, SimTruth
 from dukw_msgs.srv import SetOperator
 from rosgraph_msgs.msg import Clock
+from tf2_msgs.msg import TFMessage
 
 from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS, stamp_to_s
 from dukw_common.testing import NodeProcess, ros_node, spin_until
+from dukw_common.tf_tools import TF_QOS
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 #: Start-up on a loaded 2-core machine (imports, the physics core, discovery) can be slow.
@@ -22,7 +24,8 @@ CONTRACT = {
     '/tracks/status': 'dukw_msgs/msg/DrivetrainStatus',
     '/props/status': 'dukw_msgs/msg/DrivetrainStatus', '/rc/input': 'dukw_msgs/msg/RcInput',
     '/authority': 'dukw_msgs/msg/Authority', '/diagnostics': 'diagnostic_msgs/msg/DiagnosticArray',
-    '/sim/truth': 'dukw_msgs/msg/SimTruth', '/clock': 'rosgraph_msgs/msg/Clock'}
+    '/sim/truth': 'dukw_msgs/msg/SimTruth', '/clock': 'rosgraph_msgs/msg/Clock',
+    '/tf': 'tf2_msgs/msg/TFMessage'}      # odom -> base_link_truth, the true pose
 SUBSCRIBED = {'/tracks/cmd': 'dukw_msgs/msg/DiffCommand',
               '/props/cmd': 'dukw_msgs/msg/DiffCommand'}
 
@@ -213,3 +216,25 @@ def test_a_bad_start_is_refused_with_exit_2(sim_factory):
     proc.proc.wait(timeout=30)
     assert proc.stop() == 2
     assert 'start_at' in proc.stderr and 'Traceback' not in proc.stderr
+
+
+def test_the_true_pose_is_on_tf_as_its_own_frame(sim_factory):
+    proc = sim_factory('start_yaw_rad:=0.5')
+    truths, tfs = {}, []
+    with ros_node('probe_truth_tf') as (node, executor):
+        node.create_subscription(SimTruth, 'sim/truth',
+                                 lambda m: truths.setdefault(stamp_to_s(m.header.stamp), m),
+                                 SENSOR_QOS)
+        node.create_subscription(TFMessage, '/tf', tfs.append, TF_QOS)
+
+        def matched():
+            return [t for m in tfs for t in m.transforms
+                    if stamp_to_s(t.header.stamp) in truths]
+        assert spin_until(executor, lambda: len(matched()) >= 3, STARTUP_S), proc.stderr
+    for tf in matched():
+        truth = truths[stamp_to_s(tf.header.stamp)]
+        assert (tf.header.frame_id, tf.child_frame_id) == ('odom', 'base_link_truth')
+        p, q = tf.transform.translation, tf.transform.rotation
+        assert (p.x, p.y, p.z) == pytest.approx((truth.x_m, truth.y_m, truth.z_m))
+        assert 2 * math.atan2(q.z, q.w) == pytest.approx(truth.yaw_rad, abs=0.02)
+        assert truth.yaw_rad == pytest.approx(0.5, abs=0.05)
