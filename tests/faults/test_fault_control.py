@@ -36,8 +36,8 @@ class Rig:
     def __init__(self, node, executor):
         self.node, self.executor = node, executor
         kinds = (('imu/data', Imu, SENSOR_QOS), ('odometry/filtered', Odometry, SENSOR_QOS),
-                 ('cmd_vel', TwistStamped, COMMAND_QOS), ('water/contact', WaterContact, SENSOR_QOS),
-                 ('traction', Traction, SENSOR_QOS),
+                 ('cmd_vel', TwistStamped, COMMAND_QOS),
+                 ('water/contact', WaterContact, SENSOR_QOS), ('traction', Traction, SENSOR_QOS),
                  ('tracks/status', DrivetrainStatus, SENSOR_QOS),
                  ('authority', Authority, STATE_QOS))
         self.pubs = {topic: node.create_publisher(kind, topic, qos) for topic, kind, qos in kinds}
