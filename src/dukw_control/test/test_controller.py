@@ -113,6 +113,7 @@ def test_a_stamp_ages_the_request_and_a_stale_stamp_counts_as_a_timeout(controll
         assert not r.c.on_cmd_vel(1.0, 0.0, r.t, stamp_s=r.t - timeout_s)
         r.c.on_track_currents(20.0, 20.0, r.t)
         r.c.on_pitch(0.0, r.t)
+        r.c.on_attitude(r.t, r.t)
         out = r.c.step(r.t)
     assert out.neutral_reason == 'cmd_vel timed out' and r.t - last_fresh_t >= timeout_s
     assert 'treated as timed out' in r.c.i.last_rejection
