@@ -227,3 +227,16 @@ def publisher_sources(node, topic: str) -> tuple[int, tuple[str, ...]]:
         return count, ()
     infos = node.get_publishers_info_by_topic(node.resolve_topic_name(topic))
     return count, tuple(f'{i.node_namespace.rstrip("/")}/{i.node_name}' for i in infos)
+
+
+def refuse_second_client(node, sources, service: str, report: Callable[[], None]) -> str:
+    """Single-source rule for a state-changing ``service``: count its clients into the
+    SourceWatch ``sources``; on a second client (or when the verdict changes) call
+    ``report`` (publish /diagnostics now). Returns the refusal, '' when the call may go on."""
+    if sources.update(service, node.count_clients(service)) or sources.fault():
+        report()
+    if not sources.fault():
+        return ''
+    refusal = f'refused: {sources.fault()}'   # no one can tell which client is the operator
+    node.get_logger().error(f'{service} {refusal}')
+    return refusal

@@ -29,7 +29,8 @@ SPECS = [
     ParamSpec('period_s', 'zigzag: the pair swaps every period, s', 0.1, 600.0),
     ParamSpec('command_pct', 'incline / transition: straight command, %', -100.0, 100.0),
     ParamSpec('duration_s', 'length of the run, s', 0.1, 3600.0),
-    ParamSpec('authority_wait_s', 'give up without authority after, s', 0.1, 3600.0),
+    ParamSpec('authority_wait_s', 'give up without authority (and, on tracks, a first '
+              'tracks/status) after, s', 0.1, 3600.0),
     ParamSpec('incline_sustained_time_s', 'beyond limits.incline_sustained_rad this long: '
               'abort, s', 0.0, 600.0),
     ParamSpec('current_peak_a', 'track current ceiling while allowance is left, A', 0.0, 200.0),
@@ -54,14 +55,13 @@ class ManeuverNode(Node):
             incline = InclineGuard(lim.incline_sustained_rad, lim.incline_brief_rad,
                                    p['incline_sustained_time_s'], 0.0)
             self.player = ManeuverPlayer(plan, p['actuators'], drive.port_bias_pct, incline,
-                                         {s: CurrentLimiter(current) for s in ('port', 'stbd')})
+                                         {s: CurrentLimiter(current) for s in ('port', 'stbd')},
+                                         p['authority_wait_s'], p['status_timeout_s'])
         except ValueError as exc:
             raise ConfigError(f'maneuver_node: {exc}') from exc
-        self.params = p
         self.usable = False
         self.incline_rad = 0.0
-        self.start_s = self.last_s = self.now_s()
-        self.status_s = None
+        self.last_s = self.now_s()
         self.end_s = None
         self.commands = ActuatorPublishers(self, COMMAND_QOS)
         self.create_subscription(Authority, 'authority', self.on_authority, STATE_QOS)
@@ -83,21 +83,11 @@ class ManeuverNode(Node):
         self.incline_rad = -pitch_from_quaternion(msg.orientation)
 
     def on_tracks(self, msg: DrivetrainStatus) -> None:
-        now = self.now_s()
-        dt = 0.0 if self.status_s is None else min(now - self.status_s, 0.5)
-        self.status_s = now
-        self.player.current['port'].update(msg.port.current_a, dt)
-        self.player.current['stbd'].update(msg.stbd.current_a, dt)
+        self.player.on_status(self.now_s(), msg.port.current_a, msg.stbd.current_a)
 
     def on_timer(self) -> None:
         now, player = self.now_s(), self.player
         dt, self.last_s = min(max(now - self.last_s, 0.0), 0.1), now
-        if player.state == PlayerState.WAITING and now - self.start_s > \
-                self.params['authority_wait_s']:
-            player.abort('the computer never got authority')
-        if player.state == PlayerState.PLAYING and player.actuators != 'props' and (
-                self.status_s is None or now - self.status_s > self.params['status_timeout_s']):
-            player.abort('tracks/status stale: the current limit cannot be watched')
         before = player.state
         tracks, props = player.step(now, self.usable, self.incline_rad, dt)
         self.commands.publish(tracks, props)

@@ -68,14 +68,48 @@ class ManeuverPlayer:
     """Plays a plan with the bias applied; aborts to neutral on the operator or a limit."""
 
     def __init__(self, plan: ManeuverPlan, actuators: str, port_bias_pct: float,
-                 incline: InclineGuard, current: dict[str, CurrentLimiter]) -> None:
+                 incline: InclineGuard, current: dict[str, CurrentLimiter],
+                 start_wait_s: float, status_timeout_s: float) -> None:
         if actuators not in ACTUATORS:
             raise ValueError(f'unknown actuators {actuators!r}; known: {ACTUATORS}')
+        if not (start_wait_s > 0.0 and status_timeout_s > 0.0):
+            raise ValueError('start_wait_s and status_timeout_s must be > 0')
         self.plan, self.actuators, self.port_bias_pct = plan, actuators, port_bias_pct
         self.incline, self.current = incline, current
+        self.start_wait_s, self.status_timeout_s = start_wait_s, status_timeout_s
         self.state = PlayerState.WAITING
         self.reason = ''
         self._start_s = 0.0
+        self._waiting_since_s: float | None = None
+        self._status_s: float | None = None     # last tracks/status; None: none yet
+
+    def on_status(self, now_s: float, port_current_a: float, stbd_current_a: float) -> None:
+        """A tracks/status at ``now_s``: feeds the current limits, keeps the status fresh."""
+        dt_s = 0.0 if self._status_s is None else min(max(now_s - self._status_s, 0.0), 0.5)
+        self._status_s = now_s
+        self.current['port'].update(port_current_a, dt_s)
+        self.current['stbd'].update(stbd_current_a, dt_s)
+
+    def _status_missing(self, now_s: float) -> str:
+        """'' when tracks/status is not needed or fresh, else what is wrong with it."""
+        if self.actuators == 'props':
+            return ''
+        if self._status_s is None:
+            return 'tracks/status never arrived'
+        if now_s - self._status_s > self.status_timeout_s:
+            return 'tracks/status stale'
+        return ''
+
+    def _wait(self, now_s: float, authority_usable: bool) -> None:
+        """Start once authority and a fresh tracks/status are there; give up after
+        ``start_wait_s`` (a status not there yet is waited for, not stale)."""
+        if self._waiting_since_s is None:
+            self._waiting_since_s = now_s
+        missing = self._status_missing(now_s)
+        if authority_usable and not missing:
+            self.state, self._start_s = PlayerState.PLAYING, now_s
+        elif now_s - self._waiting_since_s > self.start_wait_s:
+            self.abort(missing if authority_usable else 'the computer never got authority')
 
     def abort(self, reason: str) -> None:
         """Stop for good (neutral from now on)."""
@@ -85,12 +119,14 @@ class ManeuverPlayer:
     def step(self, now_s: float, authority_usable: bool, incline_rad: float,
              dt_s: float) -> tuple[SidePair, SidePair]:
         """(tracks, props) to publish at ``now_s``."""
-        if self.state == PlayerState.WAITING and authority_usable:
-            self.state, self._start_s = PlayerState.PLAYING, now_s
+        if self.state == PlayerState.WAITING:
+            self._wait(now_s, authority_usable)
         if self.state != PlayerState.PLAYING:
             return NEUTRAL, NEUTRAL
         if not authority_usable:
             self.abort('the RC operator took over (or the link dropped)')
+        if self._status_missing(now_s):
+            self.abort(f'{self._status_missing(now_s)}: the current limit cannot be watched')
         if self.actuators != 'props' and self.incline.update(incline_rad, dt_s) and \
                 self.incline.stopping:
             self.abort(f'incline limit: {self.incline.state.value}')

@@ -14,7 +14,8 @@ from dukw_common.config import ConfigError
 from dukw_common.diagnostics import Health, Level
 from dukw_common.sources import SourceWatch
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
-                                    declare_parameters, diagnostic_array, run_node)
+                                    declare_parameters, diagnostic_array, refuse_second_client,
+                                    run_node)
 from dukw_control.convert import decision_to_msg, stamp_or
 from dukw_control.modes import NODE_PARAMS, Mode, ModeManager, settings_from_params
 
@@ -66,12 +67,9 @@ class ModeManagerNode(Node):
         self.core.on_attitude(stamp_or(msg, now), now)
 
     def on_set_mode(self, request: SetMode.Request, response: SetMode.Response):
-        if self.sources.update('set_mode', self.count_clients('set_mode')) or \
-                self.sources.fault():
-            self.publish_diagnostics()
-        if self.sources.fault():            # no one can tell which client is the operator
-            response.success, response.message = False, f'refused: {self.sources.fault()}'
-            self.get_logger().error(f'set_mode {response.message}')
+        refusal = refuse_second_client(self, self.sources, 'set_mode', self.publish_diagnostics)
+        if refusal:
+            response.success, response.message = False, refusal
             return response
         if request.automatic:
             self.core.release(self.now_s())

@@ -178,3 +178,22 @@ def test_maneuver_node_plays_with_bias_and_aborts_when_the_operator_takes_over()
             assert not proc.alive(), 'maneuver_node should exit after an abort'
         assert 'RC operator' in proc.stderr, proc.stderr
         assert proc.proc.returncode == 0 and 'Traceback' not in proc.stderr, proc.stderr
+
+
+def test_maneuver_node_waits_for_a_first_tracks_status_after_authority():
+    with ros_node('maneuver_probe') as (node, executor):
+        tracks = []
+        node.create_subscription(DiffCommand, 'tracks/cmd', tracks.append, COMMAND_QOS)
+        auth = node.create_publisher(Authority, 'authority', STATE_QOS)
+        status = node.create_publisher(DrivetrainStatus, 'tracks/status', SENSOR_QOS)
+        auth.publish(authority(Authority.HOLDER_COMPUTER))     # latched, before any status
+        args = ['--ros-args', '-p', 'maneuver:=circle', '-p', 'duration_s:=60.0']
+        with NodeProcess('dukw_control', 'maneuver_node', args) as proc:
+            assert spin_until(executor, lambda: tracks, 30.0), proc.stderr   # it runs ...
+            spin_until(executor, lambda: False, 1.5)      # ... with authority, no status
+            assert proc.alive() and all(m.stbd_pct == 0.0 for m in tracks), proc.stderr
+            node.create_timer(0.05, lambda: status.publish(tracks_status()))
+            assert spin_until(executor, lambda: tracks[-1].stbd_pct == 100.0, 10.0), \
+                proc.stderr
+            assert proc.alive(), proc.stderr
+        assert 'stale' not in proc.stderr and 'Traceback' not in proc.stderr, proc.stderr

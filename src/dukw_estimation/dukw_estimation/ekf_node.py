@@ -17,8 +17,11 @@ from sensor_msgs.msg import Imu, NavSatFix
 from tf2_msgs.msg import TFMessage
 
 from dukw_common.config import node_params, section
+from dukw_common.diagnostics import Health, Level
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, ParamSpec, declare_parameters,
-                                    diagnostic_array, run_node, s_to_stamp, vehicle_specs)
+                                    diagnostic_array, refuse_second_client, run_node,
+                                    s_to_stamp, vehicle_specs)
+from dukw_common.sources import SourceWatch
 from dukw_common.tf_tools import TF_QOS, odometry_tf
 from dukw_common.vehicle import Vehicle, soil_params
 from dukw_estimation import ros_convert as conv
@@ -45,6 +48,7 @@ class EkfNode(Node):
         self.settings = EkfSettings.from_params(params)
         self.publish_on_imu = bool(params['publish_on_imu'])
         self.last_event_publish_s = -1.0
+        self.sources = SourceWatch()               # set_pose: one client, the operator's
         soil = soil_params(params, self.settings.soil_preset or None)
         self.estimator = Estimator(Vehicle.from_params(params), self.settings, soil)
         self.odom_pub = self.create_publisher(Odometry, 'odometry/filtered', COMMAND_QOS)
@@ -100,13 +104,15 @@ class EkfNode(Node):
         self.traction_pub.publish(conv.traction_msg(est.traction(), stamp, Traction))
 
     def _on_diagnostics(self) -> None:
-        self.diag_pub.publish(diagnostic_array(self, self.estimator.health(self._now_s())))
+        healths = self.estimator.health(self._now_s())
+        if self.sources.fault():                   # a second set_pose client
+            healths.append(Health('set_pose', Level.ERROR, self.sources.fault()))
+        self.diag_pub.publish(diagnostic_array(self, healths))
 
     def _on_set_pose(self, request, response):
-        if self.count_clients('set_pose') > 1:     # one client (the operator's) or none
-            response.success = False
-            response.message = f"refused: set_pose has {self.count_clients('set_pose')} clients"
-            self.get_logger().error(response.message)
+        refusal = refuse_second_client(self, self.sources, 'set_pose', self._on_diagnostics)
+        if refusal:                                # one client (the operator's) or none
+            response.success, response.message = False, refusal
             return response
         response.success = self.estimator.set_pose(request.x_m, request.y_m, request.yaw_rad)
         response.message = 'pose set' if response.success else 'refused: non-finite pose'
