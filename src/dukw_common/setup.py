@@ -13,6 +13,7 @@ setup(
         ('share/' + package_name, ['package.xml']),
         # The workspace's parameter files, so installed nodes find their defaults.
         ('share/' + package_name + '/config', glob('config/*.yaml')),
+        ('share/' + package_name + '/config/reference', glob('config/reference/*.yaml')),
     ],
     install_requires=['setuptools'],
     zip_safe=True,
