@@ -1,6 +1,7 @@
 """validate: the simulator against the paper's field measurements (issue 13).
 
-    validate [--reference PATH] [--only GROUP ...] [--plots DIR] [--seed N] [--config PATH]
+    validate [--reference PATH] [--only GROUP ...] [--plots DIR] [--set NAME=VALUE ...]
+             [--seed N] [--config PATH]
 
 Runs each reference manoeuvre of ``config/reference/paper.yaml`` on the simulator core
 (dukw_sim.maneuver), prints one line per check (simulated, paper, tolerance, ok/OFF) and
@@ -13,6 +14,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Sequence
@@ -282,6 +284,34 @@ def report(res: Results) -> list[str]:
     return lines
 
 
+def config_with(settings: Sequence[str], config: str | None, folder: Path) -> str:
+    """Write the parameter file with ``NAME=VALUE`` settings (sim_node's or the shared
+    block's dotted names, numbers) into ``folder``; return its path. ValueError if unknown."""
+    source = Path(config) if config else default_config_path()
+    doc = yaml.safe_load(source.read_text())
+    for setting in settings:
+        name, sep, text = setting.partition('=')
+        try:
+            value = float(text)
+        except ValueError:
+            value = None
+        if not sep or value is None:
+            raise ValueError(f'--set needs NAME=NUMBER, got {setting!r}')
+        for block in ('sim_node', '/**'):
+            tree = doc[block]['ros__parameters']
+            *path, leaf = name.split('.')
+            for key in path:
+                tree = tree.get(key) if isinstance(tree, dict) else None
+            if isinstance(tree, dict) and leaf in tree:
+                tree[leaf] = value
+                break
+        else:
+            raise ValueError(f'--set: no parameter {name!r} in sim_node or /**')
+    out = folder / 'validate_config.yaml'
+    out.write_text(yaml.safe_dump(doc))
+    return str(out)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The command line."""
     parser = argparse.ArgumentParser(prog='validate', description=__doc__.splitlines()[0])
@@ -291,6 +321,9 @@ def build_parser() -> argparse.ArgumentParser:
                         help=f'run only these groups ({", ".join(GROUPS)})')
     parser.add_argument('--no-zigzags', action='store_true', help='skip the zigzag fits')
     parser.add_argument('--plots', metavar='DIR', help='write comparison plots (PNG) here')
+    parser.add_argument('--set', action='append', default=[], metavar='NAME=VALUE',
+                        help='run with this parameter changed (sim_node or shared dotted name, '
+                        'e.g. land.lateral_friction_coeff=0.11); repeatable')
     parser.add_argument('--seed', type=int, default=0, help='random seed (waves)')
     parser.add_argument('--config', metavar='PATH', help="parameter file (default: the stack's)")
     return parser
@@ -302,8 +335,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         reference = load_reference(args.reference)
-        res = run_all(reference, args.only or GROUPS, not args.no_zigzags, args.seed,
-                      args.config)
+        with tempfile.TemporaryDirectory() as folder:
+            config = config_with(args.set, args.config, Path(folder)) if args.set \
+                else args.config
+            res = run_all(reference, args.only or GROUPS, not args.no_zigzags, args.seed,
+                          config)
     except (ConfigError, KeyError, ValueError, OSError) as exc:
         parser.error(str(exc))
     for line in report(res):

@@ -80,3 +80,24 @@ def test_bad_reference_is_a_clear_error(tmp_path):
                            str(tmp_path / 'missing.yaml')], capture_output=True, text=True,
                           timeout=60)
     assert proc.returncode == 2 and 'cannot read reference file' in proc.stderr
+
+
+#: The optional skid-steer set of config/dukw.yaml (sim_node land.*, issue 13).
+SKID_STEER = ['drivetrain.port_extra_friction_n=0', 'land.speed_loop_droop_mps_per_kn=1.43',
+              'land.lateral_friction_coeff=0.11', 'land.lateral_slip_speed_mps=0.05',
+              'land.lateral_damping_n_per_mps=1600']
+
+
+def test_skid_steer_set_meets_the_land_turns_and_equal_command_inclines(capsys):
+    """Radius grows as the differential shrinks (8 radii within 20 %), the port bias holds
+    and the equal-command incline currents come out (port below starboard, +-15 %)."""
+    args = ['--only', 'land_turns', 'port_bias', 'inclines', '--no-zigzags']
+    assert validate.main(args + [a for s in SKID_STEER for a in ('--set', s)]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == 'score: 16/16 checks ok'
+
+
+def test_set_rejects_an_unknown_parameter(tmp_path):
+    with pytest.raises(ValueError, match='no parameter'):
+        validate.config_with(['land.no_such_thing=1'], None, tmp_path)
+    with pytest.raises(ValueError, match='NAME=NUMBER'):
+        validate.config_with(['land.lateral_friction_coeff'], None, tmp_path)
