@@ -452,8 +452,7 @@ class SimCore:
         half = self._half_sep
         ground_new = (self.u - self.r * half, self.u + self.r * half)
         speeds = [motor_limited_speed(contact, self.ref[i], ground_new[i], new[i])
-                  if limited[i] else self._loaded_speed(i, new[i] + others[i], contact,
-                                                        loop_k[i])
+                  if limited[i] else self._loaded_speed(i, new[i] + others[i], loop_k[i])
                   for i in range(2)]
         self.track_speed = speeds
         slips = traction.slip(np.array(speeds), np.array(ground_new)).tolist()
@@ -574,7 +573,7 @@ class SimCore:
             dr = dt * (n0 + (force[1] - force[0]) * half) / (i_z - dt * j_r)
         return du, dr, force, limited
 
-    def _loaded_speed(self, i: int, motor_force_n: float, contact, loop_k: float) -> float:
+    def _loaded_speed(self, i: int, motor_force_n: float, loop_k: float) -> float:
         """Track speed of a speed loop (not at its current limit) giving this force, m/s."""
         if math.isinf(loop_k):
             return self.ref[i]
