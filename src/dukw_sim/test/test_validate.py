@@ -101,3 +101,18 @@ def test_set_rejects_an_unknown_parameter(tmp_path):
         validate.config_with(['land.no_such_thing=1'], None, tmp_path)
     with pytest.raises(ValueError, match='NAME=NUMBER'):
         validate.config_with(['land.lateral_friction_coeff'], None, tmp_path)
+
+
+def test_full_run_as_installed_reports_every_check_and_its_exit_code(tmp_path):
+    """The console script, every group and the zigzags (about 20 s of physics)."""
+    proc = subprocess.run([sys.executable, '-m', 'dukw_sim.validate', '--plots',
+                           str(tmp_path)], capture_output=True, text=True, timeout=600)
+    lines = proc.stdout.splitlines()
+    checks = [line for line in lines
+              if line.endswith((' ok', 'OFF')) and not line.startswith('score:')]
+    ok = sum(line.endswith(' ok') for line in checks)
+    assert len(checks) == 38
+    assert f'score: {ok}/38 checks ok' in lines
+    assert proc.returncode == (0 if ok == 38 else 1), proc.stderr
+    assert sum(line.startswith('zigzag (info)') for line in lines) == 2
+    assert len(list(tmp_path.glob('*.png'))) == 7
