@@ -116,3 +116,16 @@ def test_full_run_as_installed_reports_every_check_and_its_exit_code(tmp_path):
     assert proc.returncode == (0 if ok == 38 else 1), proc.stderr
     assert sum(line.startswith('zigzag (info)') for line in lines) == 2
     assert len(list(tmp_path.glob('*.png'))) == 7
+
+
+#: The optional water-turn set of config/dukw.yaml (sim_node water.* comment, issue 13).
+WATER_TURNS = ['drivetrain.prop_reverse_thrust_ratio=0.78',
+               'water.yaw_linear_drag_nm_per_rps=620',
+               'water.yaw_quadratic_drag_nm_per_rps2=1800']
+
+
+def test_water_turn_set_meets_the_water_turns(capsys):
+    """One propeller stopped gives an 11-12 m circle, both at +-100 % about 2.5 m."""
+    args = ['--only', 'water_turns', '--no-zigzags']
+    assert validate.main(args + [a for s in WATER_TURNS for a in ('--set', s)]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == 'score: 8/8 checks ok'
