@@ -37,6 +37,12 @@ def test_config_installed_with_the_stack():
     assert installed.read_text() == (WORKSPACE / 'config/dukw.yaml').read_text()
 
 
+def test_paper_reference_installed_with_the_stack():
+    installed = Path(get_package_share_directory('dukw_common')) / 'config/reference/paper.yaml'
+    assert installed.read_text() == (WORKSPACE / 'config/reference/paper.yaml').read_text()
+    assert (WORKSPACE / 'install/lib/dukw_sim/validate').is_file()
+
+
 def test_generated_interfaces_import():
     from dukw_msgs import msg, srv
     for name in ['DiffCommand', 'MotorSide', 'DrivetrainStatus', 'WaterContact', 'Depth',

@@ -21,6 +21,7 @@ setup(
         'console_scripts': [
             'sim_node = dukw_sim.sim_node:main',
             'maneuver = dukw_sim.maneuver:main',
+            'validate = dukw_sim.validate:main',
         ],
     },
 )

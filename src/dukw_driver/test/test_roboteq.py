@@ -72,7 +72,7 @@ def test_track_speed_and_thrust_models():
     rpm = 2.0 / (math.pi * DRIVETRAIN.sprocket_diameter_m) * 60 * DRIVETRAIN.gear_reduction
     assert track_speed_mps(rpm, DRIVETRAIN) == pytest.approx(2.0)
     assert prop_thrust_n(100.0, DRIVETRAIN) == pytest.approx(133.0)
-    assert prop_thrust_n(-100.0, DRIVETRAIN) == pytest.approx(-133.0 * 0.6)
+    assert prop_thrust_n(-100.0, DRIVETRAIN) == pytest.approx(-133.0 * 0.78)   # reverse weaker
 
 
 def run(monitor, device, t0, t1, dt=0.05):

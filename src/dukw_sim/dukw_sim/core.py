@@ -124,7 +124,10 @@ class SimCore:
         self._kg = body.kg_m
         self._max_motor_n = drive.track_force_gain_n_per_a * (
             land.max_current_a - drive.no_load_current_a)
-        self._port_droop_mps = drive.port_extra_friction_n / land.speed_loop_stiffness_n_per_mps
+        self._port_droop_mps = (land.port_speed_deficit_pct / 100.0
+                                * drive.full_scale_track_speed_mps)
+        droop = land.speed_loop_droop_mps_per_kn / 1000.0       # m/s per N
+        self._loop_k = 1.0 / droop if droop > 0.0 else math.inf   # N per m/s
         self._wet_soil = _soil_with_floor(vehicle.soil, land.min_shear_modulus_m)
         dry = params.dry_soil or vehicle.soil
         self._dry_soil = _soil_with_floor(dry, land.min_shear_modulus_m)
@@ -327,7 +330,8 @@ class SimCore:
         paddle = []
         for i in range(2):
             fric = drive.friction_n + (drive.port_extra_friction_n if i == 0 else 0.0)
-            ts = self.track_speed[i]
+            # a loaded loop's speed follows the load: take its reference (no feedback chatter)
+            ts = self.ref[i] if math.isfinite(self._loop_k) else self.track_speed[i]
             if abs(ts) < _BREAKAWAY_MPS:
                 fric *= 1.0 + (land.breakaway_friction_ratio - 1.0) * (
                     1.0 - abs(ts) / _BREAKAWAY_MPS)
@@ -339,7 +343,10 @@ class SimCore:
         soil = self._dry_soil if self.x < p.world.wet_sand_start_x_m else self._wet_soil
         contact = TrackContact(w_eff / 2.0, soil, self._track_area, self._track_len) \
             if w_eff > 0.0 else None
-        lin = linearise(contact, tuple(self.ref), ground)
+        # the speed loops give under load; at a zero command they hold the track (brake)
+        loop_k = tuple(self._loop_k if targets[i] != 0.0 else math.inf for i in range(2))
+        lin = linearise(contact, tuple(self.ref), ground, tuple(others), loop_k,
+                        tuple(self.track_speed))
 
         # --- forces in body axes (X forward, Y left, N yaw) and their derivatives, all but
         # the tracks' soil forces (added in the implicit solve below)
@@ -359,12 +366,13 @@ class SimCore:
                 j_r -= dth * self._half_sep ** 2
             lat_n = land.lateral_friction_coeff * w_eff / _LATERAL_POINTS
             v_ref = land.lateral_slip_speed_mps
+            lat_c = land.lateral_damping_n_per_mps * w_eff / self._weight / _LATERAL_POINTS
             for s_j in self._lat_s:
                 th = math.tanh((v0 + r0 * s_j) / v_ref)
-                f = -lat_n * th
+                f = -lat_n * th - lat_c * (v0 + r0 * s_j)
                 Y += f
                 N += f * s_j
-                d = lat_n * (1.0 - th * th) / v_ref
+                d = lat_n * (1.0 - th * th) / v_ref + lat_c
                 j_v -= d
                 j_r -= d * s_j * s_j
             # gravity along the slope: (Delta - B) sin(theta), downhill, odom -> body
@@ -424,22 +432,28 @@ class SimCore:
                 converged = True
                 break
             g_lin = g_next
-            lin = linearise(contact, tuple(self.ref), g_lin)
+            lin = linearise(contact, tuple(self.ref), g_lin, tuple(others), loop_k,
+                            tuple(lin.speed_mps))
         if contact is not None and any(
-                (self.ref[i] - ground[i]) * (self.ref[i] - ground[i] - du
-                                             + (1.0, -1.0)[i] * dr * half) < 0.0
+                (lin.speed_mps[i] - ground[i]) * (lin.speed_mps[i] - ground[i] - du
+                                                  + (1.0, -1.0)[i] * dr * half) < 0.0
                 for i in range(2)):
             converged = False          # a track's slip would change sign within the step
         if not converged:
             # the soil force is nearly a step at these slips (firm sand, low speed): the
             # tracks grip; solve the step with the ground under the tracks moving at the
-            # tracks' speeds, within what the soil and the motors can give
-            du, dr, new, limited = self._grip_step(base, contact, u0, r0, others)
+            # tracks' (loaded) speeds, within what the soil and the motors can give
+            if any(math.isinf(k) for k in loop_k):
+                du, dr, new, limited = self._grip_step(base, contact, u0, r0, others)
+            else:
+                du, dr, new, limited = self._loaded_grip_step(base, contact, u0, r0, others,
+                                                              loop_k)
         self.u, self.v, self.r = u0 + du, v0 + dv, r0 + dr
         half = self._half_sep
         ground_new = (self.u - self.r * half, self.u + self.r * half)
         speeds = [motor_limited_speed(contact, self.ref[i], ground_new[i], new[i])
-                  if limited[i] else self.ref[i] for i in range(2)]
+                  if limited[i] else self._loaded_speed(i, new[i] + others[i], loop_k[i])
+                  for i in range(2)]
         self.track_speed = speeds
         slips = traction.slip(np.array(speeds), np.array(ground_new)).tolist()
         tracks = TrackState(speeds, new, [new[i] + others[i] for i in range(2)], slips)
@@ -533,6 +547,37 @@ class SimCore:
             du = dt * (x0 + force[0] + force[1]) / (m_x - dt * j_u)
             dr = dt * (n0 + (force[1] - force[0]) * half) / (i_z - dt * j_r)
         return du, dr, force, limited
+
+    def _loaded_grip_step(self, base: tuple, contact, u0: float, r0: float, others: list,
+                          loop_k: tuple):
+        """As _grip_step, with the tracks' speeds those of loaded speed loops:
+        F_i + o_i = k_i (ref_i - g_i), g the new ground speeds (linear, decoupled)."""
+        x0, n0, m_x, i_z, j_u, j_r = base
+        dt, half = self.dt_s, self._half_sep
+        a = [loop_k[0] * (self.ref[0] - u0 + r0 * half) - others[0],
+             loop_k[1] * (self.ref[1] - u0 - r0 * half) - others[1]]
+        k_sum = loop_k[0] + loop_k[1]
+        du = dt * (x0 + a[0] + a[1]) / (m_x - dt * j_u + dt * k_sum)
+        dr = dt * (n0 + (a[1] - a[0]) * half) / (i_z - dt * j_r + dt * k_sum * half * half)
+        force = [a[0] - loop_k[0] * (du - dr * half), a[1] - loop_k[1] * (du + dr * half)]
+        strength = float(traction.max_traction_n(contact.weight_per_track_n, contact.soil,
+                                                 contact.area_m2))
+        limited = [False, False]
+        for i in range(2):
+            lo = max(-strength, -self._max_motor_n - others[i])
+            hi = min(strength, self._max_motor_n - others[i])
+            limited[i] = not lo <= force[i] <= hi
+            force[i] = min(max(force[i], lo), hi)
+        if any(limited):
+            du = dt * (x0 + force[0] + force[1]) / (m_x - dt * j_u)
+            dr = dt * (n0 + (force[1] - force[0]) * half) / (i_z - dt * j_r)
+        return du, dr, force, limited
+
+    def _loaded_speed(self, i: int, motor_force_n: float, loop_k: float) -> float:
+        """Track speed of a speed loop (not at its current limit) giving this force, m/s."""
+        if math.isinf(loop_k):
+            return self.ref[i]
+        return self.ref[i] - motor_force_n / loop_k      # afloat too: friction, paddling
 
     def _thrust(self, pct: float) -> float:
         """Propeller thrust for a command, N (reverse weaker, vehicle.md section 1)."""

@@ -13,7 +13,8 @@ The force on the vehicle (a track running backwards pushes backwards) is the sha
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -22,6 +23,9 @@ from dukw_estimation import traction
 
 _GRID = np.linspace(0.0, 1.0, 41)
 _PROBE_MPS = 1e-3          # ground-speed step for the force derivative
+_COMPLIANCE_ITERATIONS = 60   # safeguarded Newton steps for the loaded track speed (the
+                              # soil force is steep near no slip: up to ~40 bisections)
+_COMPLIANCE_TOL_N = 0.02
 
 
 @dataclass(frozen=True)
@@ -41,21 +45,73 @@ class TrackContact:
 
 @dataclass
 class TrackLinear:
-    """Both tracks' soil forces at the speed loops' references, and their derivatives."""
+    """Both tracks' soil forces at the speed loops' equilibrium, and their derivatives."""
 
     force_n: list            # port, starboard; + pushes the vehicle forward
     dforce_dground: list     # d force / d ground speed, N s/m (<= 0)
+    speed_mps: list = field(default_factory=lambda: [0.0, 0.0])   # the tracks' speeds
 
 
-def linearise(contact: TrackContact | None, ref_mps: tuple, ground_mps: tuple) -> TrackLinear:
-    """Soil forces of tracks running at the references, linearised in the ground speeds."""
+def _compliant_speeds(contact: TrackContact, ref: np.ndarray, ground: np.ndarray,
+                      others: np.ndarray, stiffness: np.ndarray,
+                      guess: np.ndarray) -> np.ndarray:
+    """Track speeds where the speed loops' force k (ref - v) equals soil + other forces.
+
+    h(v) = F_soil(v, g) + others - k (ref - v) rises with v; safeguarded Newton inside the
+    bracket the soil's strength S gives: v in [ref - (S + o)/k, ref + (S - o)/k].
+    """
+    strength = float(traction.max_traction_n(contact.weight_per_track_n, contact.soil,
+                                             contact.area_m2))
+    lo = ref - (strength + others) / stiffness
+    hi = ref + (strength - others) / stiffness
+    v = np.clip(guess, lo, hi)
+    for _ in range(_COMPLIANCE_ITERATIONS):
+        f = contact.forces_n(np.concatenate([v, v + _PROBE_MPS]), np.concatenate([ground,
+                                                                                 ground]))
+        h = f[:2] + others - stiffness * (ref - v)
+        if np.all(np.abs(h) < _COMPLIANCE_TOL_N):
+            break
+        hi = np.where(h > 0.0, v, hi)
+        lo = np.where(h > 0.0, lo, v)
+        slope = (f[2:] - f[:2]) / _PROBE_MPS + stiffness
+        step = v - h / slope
+        v = np.where((step > lo) & (step < hi), step, 0.5 * (lo + hi))
+    return v
+
+
+def linearise(contact: TrackContact | None, ref_mps: tuple, ground_mps: tuple,
+              others_n: tuple = (0.0, 0.0), stiffness_n_per_mps: tuple = (math.inf, math.inf),
+              guess_mps: tuple | None = None) -> TrackLinear:
+    """Soil forces of the tracks linearised in the ground speeds.
+
+    With a finite speed-loop stiffness k the track slows under load, v = ref - (F + o)/k
+    (a proportional speed controller in series with the soil): the forces are taken at
+    that equilibrium and the derivative is the series one, dF/dg = D_g k / (k + D_t).
+    An infinite k (per track) holds the track at ref.
+    """
     if contact is None:
-        return TrackLinear([0.0, 0.0], [0.0, 0.0])
-    t = np.array([ref_mps[0], ref_mps[0], ref_mps[1], ref_mps[1]])
-    g = np.array([ground_mps[0], ground_mps[0] + _PROBE_MPS,
-                  ground_mps[1], ground_mps[1] + _PROBE_MPS])
+        return TrackLinear([0.0, 0.0], [0.0, 0.0], list(ref_mps))
+    ref = np.asarray(ref_mps, dtype=float)
+    ground = np.asarray(ground_mps, dtype=float)
+    stiff = np.asarray(stiffness_n_per_mps, dtype=float)
+    soft = np.isfinite(stiff)
+    speed = ref.copy()
+    if soft.any():
+        guess = ref if guess_mps is None else np.asarray(guess_mps, dtype=float)
+        k_soft = np.where(soft, stiff, 1.0)
+        speed = np.where(soft, _compliant_speeds(contact, ref, ground,
+                                                 np.asarray(others_n, dtype=float), k_soft,
+                                                 guess), ref)
+    t = np.array([speed[0], speed[0], speed[0] + _PROBE_MPS,
+                  speed[1], speed[1], speed[1] + _PROBE_MPS])
+    g = np.array([ground[0], ground[0] + _PROBE_MPS, ground[0],
+                  ground[1], ground[1] + _PROBE_MPS, ground[1]])
     f = contact.forces_n(t, g).tolist()
-    return TrackLinear([f[0], f[2]], [(f[1] - f[0]) / _PROBE_MPS, (f[3] - f[2]) / _PROBE_MPS])
+    d_g = [(f[1] - f[0]) / _PROBE_MPS, (f[4] - f[3]) / _PROBE_MPS]
+    d_t = [(f[2] - f[0]) / _PROBE_MPS, (f[5] - f[3]) / _PROBE_MPS]
+    d_g = [float(d_g[i] * stiff[i] / (stiff[i] + d_t[i])) if soft[i] else d_g[i]
+           for i in range(2)]
+    return TrackLinear([f[0], f[3]], d_g, speed.tolist())
 
 
 def motor_limited_speed(contact: TrackContact | None, ref_mps: float, ground_mps: float,

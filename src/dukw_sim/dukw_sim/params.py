@@ -72,16 +72,21 @@ class LandParams:
     max_current_a: float
     speed_loop_time_constant_s: float
     speed_loop_accel_mps2: float
-    speed_loop_stiffness_n_per_mps: float
+    speed_loop_droop_mps_per_kn: float
+    port_speed_deficit_pct: float
     breakaway_friction_ratio: float
     rolling_resistance_coeff: float
     lateral_friction_coeff: float
     lateral_slip_speed_mps: float
+    lateral_damping_n_per_mps: float
     min_shear_modulus_m: float
 
     def __post_init__(self) -> None:
         _positive(self, 'max_current_a', 'speed_loop_time_constant_s', 'speed_loop_accel_mps2',
-                  'speed_loop_stiffness_n_per_mps', 'lateral_slip_speed_mps')
+                  'lateral_slip_speed_mps')
+        if self.speed_loop_droop_mps_per_kn < 0.0 or self.lateral_damping_n_per_mps < 0.0:
+            raise ConfigError('land.speed_loop_droop_mps_per_kn and '
+                              'land.lateral_damping_n_per_mps must be >= 0')
 
 
 @dataclass(frozen=True)

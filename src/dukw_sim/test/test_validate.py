@@ -1,0 +1,125 @@
+"""validate: the simulator against the paper's field measurements (issue 13).
+
+A fast subset runs here; the full run is ``install/lib/dukw_sim/validate``.
+"""
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import yaml
+
+from dukw_sim import validate
+
+
+@pytest.fixture(scope='module')
+def reference():
+    return validate.load_reference()
+
+
+def test_reference_file_holds_every_calibration_value(reference):
+    assert [c[2] for c in reference['land_turns']['cases'][:7]] == [
+        5.34, 5.24, 3.69, 2.44, 2.21, 1.97, 1.93]
+    assert reference['water_turns']['cases'][-1] == [-100, 100, 2.52]
+    eleven, nineteen = reference['inclines']['cases']
+    assert (eleven['port_current_a'], eleven['stbd_current_a']) == (35.36, 42.53)
+    assert (nineteen['port_current_a'], nineteen['stbd_current_a']) == (54.83, 61.46)
+    assert reference['surf_transitions']['sea_to_land_force_n'] == [260.0, 403.0]
+    assert reference['drift']['rms_yaw_rate_dps'] == 5.99
+    for group in validate.GROUPS:
+        assert 'paper' in reference[group]['source']
+
+
+def test_check_bands_and_lines():
+    ok = validate.relative('g', 'x', 1.1, 1.0, 0.2, 'm')
+    off = validate.relative('g', 'x', 1.3, 1.0, 0.2, 'm')
+    nan = validate.relative('g', 'x', math.nan, 1.0, 0.2, 'm')
+    assert ok.ok and not off.ok and not nan.ok
+    assert ok.line().endswith(' ok') and off.line().endswith('OFF')
+
+
+def test_fit_percent_and_model_response():
+    y = np.sin(np.linspace(0.0, 6.0, 200))
+    assert validate.fit_percent(y, y) == pytest.approx(100.0)
+    assert validate.fit_percent(y, np.full_like(y, y.mean())) == pytest.approx(0.0)
+    model = {'A': [[0.5]], 'B': [[1.0, 0.0]], 'C': [[1.0]]}
+    out = validate.simulate_model(model, np.ones((50, 2)))
+    assert out[0, 0] == 0.0 and out[-1, 0] == pytest.approx(2.0)   # gain 1 / (1 - 0.5)
+
+
+def test_port_bias_and_zigzag_fits_run(reference, capsys):
+    res = validate.run_all(reference, ['port_bias'], zigzags=True)
+    assert len(res.checks) == 2 and all(c.ok for c in res.checks)
+    assert set(res.fits) == {'land 56/32', 'water 80/0'}
+    lines = validate.report(res)
+    assert lines[-1] == 'score: 2/2 checks ok'
+
+
+def test_exit_code_follows_the_checks(tmp_path, reference):
+    ref = dict(reference)
+    ref['port_bias'] = dict(reference['port_bias'], min_drift_deg=1e6)  # cannot be met
+    path = tmp_path / 'ref.yaml'
+    path.write_text(yaml.safe_dump(ref))
+    out = tmp_path / 'plots'
+    assert validate.main(['--reference', str(path), '--only', 'port_bias',
+                          '--no-zigzags', '--plots', str(out)]) == 1
+    assert validate.main(['--only', 'port_bias', '--no-zigzags']) == 0
+
+
+def test_plots_are_written(tmp_path, reference):
+    res = validate.run_all(reference, ['inclines'], zigzags=False)
+    from dukw_sim.validate_plots import write_plots
+    paths = write_plots(res, tmp_path)
+    assert [p.name for p in paths] == ['inclines.png']
+    assert paths[0].stat().st_size > 1000
+
+
+def test_bad_reference_is_a_clear_error(tmp_path):
+    proc = subprocess.run([sys.executable, '-m', 'dukw_sim.validate', '--reference',
+                           str(tmp_path / 'missing.yaml')], capture_output=True, text=True,
+                          timeout=60)
+    assert proc.returncode == 2 and 'cannot read reference file' in proc.stderr
+
+
+#: The optional skid-steer set of config/dukw.yaml (sim_node land.*, issue 13).
+SKID_STEER = ['drivetrain.port_extra_friction_n=0', 'land.speed_loop_droop_mps_per_kn=1.43',
+              'land.lateral_friction_coeff=0.11', 'land.lateral_slip_speed_mps=0.05',
+              'land.lateral_damping_n_per_mps=1600']
+
+
+def test_skid_steer_set_meets_the_land_turns_and_equal_command_inclines(capsys):
+    """Radius grows as the differential shrinks (8 radii within 20 %), the port bias holds
+    and the equal-command incline currents come out (port below starboard, +-15 %)."""
+    args = ['--only', 'land_turns', 'port_bias', 'inclines', '--no-zigzags']
+    assert validate.main(args + [a for s in SKID_STEER for a in ('--set', s)]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == 'score: 16/16 checks ok'
+
+
+def test_set_rejects_an_unknown_parameter(tmp_path):
+    with pytest.raises(ValueError, match='no parameter'):
+        validate.config_with(['land.no_such_thing=1'], None, tmp_path)
+    with pytest.raises(ValueError, match='NAME=NUMBER'):
+        validate.config_with(['land.lateral_friction_coeff'], None, tmp_path)
+
+
+def test_full_run_as_installed_reports_every_check_and_its_exit_code(tmp_path):
+    """The console script, every group and the zigzags (about 20 s of physics)."""
+    proc = subprocess.run([sys.executable, '-m', 'dukw_sim.validate', '--plots',
+                           str(tmp_path)], capture_output=True, text=True, timeout=600)
+    lines = proc.stdout.splitlines()
+    checks = [line for line in lines
+              if line.endswith((' ok', 'OFF')) and not line.startswith('score:')]
+    ok = sum(line.endswith(' ok') for line in checks)
+    assert len(checks) == 38
+    assert f'score: {ok}/38 checks ok' in lines
+    assert proc.returncode == (0 if ok == 38 else 1), proc.stderr
+    assert sum(line.startswith('zigzag (info)') for line in lines) == 2
+    assert len(list(tmp_path.glob('*.png'))) == 7
+
+
+
+def test_water_turns_meet_the_papers_radii(capsys):
+    """One propeller stopped gives an 11-12 m circle, both at +-100 % about 2.5 m."""
+    assert validate.main(['--only', 'water_turns', '--no-zigzags']) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == 'score: 8/8 checks ok'
