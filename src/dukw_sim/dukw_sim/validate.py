@@ -23,12 +23,15 @@ import numpy as np
 import yaml
 
 from dukw_common.config import ConfigError, default_config_path
+from dukw_estimation import sysid
 from dukw_sim import maneuver
 from dukw_sim.core import Actuation, SimCore
 from dukw_sim.truth import Medium
 
 GROUPS = ('land_turns', 'port_bias', 'inclines', 'water_turns', 'surf_transitions', 'drift')
 REFERENCE_FILE = Path('reference') / 'paper.yaml'
+#: The paper's identified models (one copy, read by sysid compare-paper too).
+PAPER_MODELS_FILE = Path('reference') / 'paper_models.yaml'
 
 
 @dataclass(frozen=True)
@@ -78,7 +81,8 @@ def reference_path() -> Path:
 
 
 def load_reference(path: str | Path | None = None) -> dict:
-    """Read the reference file; ConfigError when missing or not a mapping."""
+    """Read the reference file (or another of config/reference); ConfigError when missing
+    or not a mapping."""
     path = Path(path) if path is not None else reference_path()
     try:
         doc = yaml.safe_load(path.read_text())
@@ -216,45 +220,32 @@ _RUNNERS: dict[str, Callable] = {
 
 
 # ---------------------------------------------------------------------------- zigzags
-def simulate_model(model: dict, commands: np.ndarray) -> np.ndarray:
-    """Outputs (u, v, r) of a discrete state-space model for commands (n x 2), from rest."""
-    a, b, c = (np.asarray(model[k], dtype=float) for k in ('A', 'B', 'C'))
-    x = np.zeros(a.shape[0])
-    out = np.empty((commands.shape[0], c.shape[0]))
-    for n, u in enumerate(commands):
-        out[n] = c @ x
-        x = a @ x + b @ u
-    return out
+def zigzag_run(medium: str, high: float, low: float, ref: dict, seed: int,
+               config: str | None) -> sysid.Run:
+    """A simulated zigzag as a system-identification run (commands %, u v r REP 103)."""
+    rows = maneuver.zigzag(medium, high, low, ref['period_s'], ref['duration_s'], seed,
+                           config).rows
+    if medium == 'land':
+        cmds = [[t.port_cmd_pct, t.stbd_cmd_pct] for t in rows]
+    else:
+        cmds = [[t.port_prop_cmd_pct, t.stbd_prop_cmd_pct] for t in rows]
+    y = [[t.surge_mps, t.sway_mps, t.yaw_rate_rps] for t in rows]
+    return sysid.Run(f'{medium} {high:g}/{low:g}', medium, np.array([t.t_s for t in rows]),
+                     np.array(cmds, dtype=float), np.array(y, dtype=float))
 
 
-def fit_percent(measured: np.ndarray, predicted: np.ndarray) -> float:
-    """Normalised-RMS fit, 100 (1 - |y - yhat| / |y - mean y|), % (100 = perfect)."""
-    spread = float(np.linalg.norm(measured - np.mean(measured)))
-    if spread == 0.0:
-        return float('nan')
-    return 100.0 * (1.0 - float(np.linalg.norm(measured - predicted)) / spread)
-
-
-def zigzag_fits(ref: dict, res: Results, seed: int, config: str | None) -> None:
-    """The paper's identified models against the simulator's zigzags, fit % of u, v, r."""
+def zigzag_fits(ref: dict, res: Results, seed: int, config: str | None,
+                paper_models: dict) -> None:
+    """The paper's identified models (REP 103 outputs, about each run's own means: their
+    operating point is not published) against the simulator's zigzags, fit % of u, v, r
+    as MATLAB's compare gives it (dukw_estimation.sysid)."""
     for medium in ('land', 'water'):
         high, low = ref[medium]
-        run = maneuver.zigzag(medium, high, low, ref['period_s'], ref['duration_s'], seed,
-                              config)
-        rows = run.rows
-        if medium == 'land':
-            cmds = np.array([[t.port_cmd_pct, t.stbd_cmd_pct] for t in rows])
-        else:
-            cmds = np.array([[t.port_prop_cmd_pct, t.stbd_prop_cmd_pct] for t in rows])
-        cmds = np.vstack([cmds[1:], cmds[-1:]])       # row n holds the state before step n
-        sim = np.array([[t.surge_mps, t.sway_mps, t.yaw_rate_rps] for t in rows])
-        model = simulate_model(ref[f'{medium}_model'], cmds)
-        fits = {'u': fit_percent(sim[:, 0], model[:, 0]),
-                'v': fit_percent(sim[:, 1], model[:, 1]),
-                'r': max(fit_percent(sim[:, 2], model[:, 2]),
-                         fit_percent(np.degrees(sim[:, 2]), model[:, 2]))}
-        res.fits[f'{medium} {high:g}/{low:g}'] = fits
-        res.series[f'zigzag_{medium}'] = (np.array([t.t_s for t in rows]), sim, model)
+        run = zigzag_run(medium, high, low, ref, seed, config)
+        model = sysid.with_offsets_of(sysid.paper_model(paper_models, medium), run)
+        comparison = sysid.compare(model, run)
+        res.fits[run.name] = comparison.fit_pct
+        res.series[f'zigzag_{medium}'] = (run.t_s, run.y, comparison.y_sim)
 
 
 # ---------------------------------------------------------------------------- run
@@ -269,7 +260,8 @@ def run_all(reference: dict, groups: Sequence[str] = GROUPS, zigzags: bool = Tru
             raise ConfigError(f'reference file has no {group!r} section')
         _RUNNERS[group](reference[group], res, seed, config)
     if zigzags:
-        zigzag_fits(reference['zigzags'], res, seed, config)
+        paper_models = load_reference(default_config_path().parent / PAPER_MODELS_FILE)
+        zigzag_fits(reference['zigzags'], res, seed, config, paper_models)
     return res
 
 

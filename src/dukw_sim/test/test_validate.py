@@ -6,7 +6,6 @@ import math
 import subprocess
 import sys
 
-import numpy as np
 import pytest
 import yaml
 
@@ -39,19 +38,13 @@ def test_check_bands_and_lines():
     assert ok.line().endswith(' ok') and off.line().endswith('OFF')
 
 
-def test_fit_percent_and_model_response():
-    y = np.sin(np.linspace(0.0, 6.0, 200))
-    assert validate.fit_percent(y, y) == pytest.approx(100.0)
-    assert validate.fit_percent(y, np.full_like(y, y.mean())) == pytest.approx(0.0)
-    model = {'A': [[0.5]], 'B': [[1.0, 0.0]], 'C': [[1.0]]}
-    out = validate.simulate_model(model, np.ones((50, 2)))
-    assert out[0, 0] == 0.0 and out[-1, 0] == pytest.approx(2.0)   # gain 1 / (1 - 0.5)
-
-
 def test_port_bias_and_zigzag_fits_run(reference, capsys):
     res = validate.run_all(reference, ['port_bias'], zigzags=True)
     assert len(res.checks) == 2 and all(c.ok for c in res.checks)
     assert set(res.fits) == {'land 56/32', 'water 80/0'}
+    # the paper's models in REP 103 axes (sysid.paper_model) turn the simulator's way on its
+    # own zigzags: left in the paper's y-to-starboard frame their yaw-rate fit is below 0 %
+    assert all(fits['r'] > 0.0 for fits in res.fits.values()), res.fits
     lines = validate.report(res)
     assert lines[-1] == 'score: 2/2 checks ok'
 
