@@ -107,15 +107,16 @@ class Stack:
         return spin_until(self.executor, predicate, timeout_s)
 
 
-def position_lon_e7(gcs, stack):
-    """Ask ``status GLOBAL_POSITION_INT`` (once a second until MAVProxy has one); its lon."""
-    def answered():
-        found = re.findall(r'GLOBAL_POSITION_INT \{.*?\blon : (-?\d+)', ''.join(gcs.lines))
-        return found[asked:] if found[asked:] else None
+def status_field(gcs, stack, message, field):
+    """Ask ``status MESSAGE`` (once a second until MAVProxy has one); the field's integer."""
+    pattern = message + r' \{.*?\b' + field + r' : (-?\d+)'
+    asked = len(re.findall(pattern, ''.join(gcs.lines)))
 
-    asked = len(re.findall(r'GLOBAL_POSITION_INT \{', ''.join(gcs.lines)))
+    def answered():
+        return re.findall(pattern, ''.join(gcs.lines))[asked:]
+
     for _ in range(10):
-        gcs.command('status GLOBAL_POSITION_INT')
+        gcs.command(f'status {message}')
         if stack.wait(answered, 1.0):
             return int(answered()[-1])
     raise AssertionError(''.join(gcs.lines))
@@ -154,10 +155,12 @@ def test_mavproxy_with_the_passphrase_commands_and_without_it_cannot(tmp_path):
 def run_the_session(gcs, stack, mission, strangers):
     assert stack.wait(lambda: gcs.count('Detected vehicle 1:1'), 30.0), gcs.lines
     # (1) the position moves: GLOBAL_POSITION_INT now and 3 s later, east = lon grows
-    first = position_lon_e7(gcs, stack)
+    first = status_field(gcs, stack, 'GLOBAL_POSITION_INT', 'lon')
     stack.wait(lambda: False, 3.0)
-    second = position_lon_e7(gcs, stack)
+    second = status_field(gcs, stack, 'GLOBAL_POSITION_INT', 'lon')
     assert second - first > 100, (first, second)     # > 0.9 m east (0.5 m/s for > 3 s)
+    # home (which MAVProxy asks for with GET_HOME_POSITION until it has one) is the datum
+    assert status_field(gcs, stack, 'HOME_POSITION', 'latitude') == round(DATUM[0] * 1e7)
     # parameters: the whitelist, and a set that the vehicle confirms in STATUSTEXT
     assert stack.wait(lambda: gcs.count('Received 14 parameters'), 30.0), gcs.lines
     gcs.command('param set SHL_MAN_SPD 0.7')

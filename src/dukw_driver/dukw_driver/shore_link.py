@@ -254,6 +254,10 @@ class ShoreLink:
         if c == mavlink.MAV_CMD_REQUEST_MESSAGE:
             self._request_message(int(msg.param1), gcs)
             return []
+        if c == mavlink.MAV_CMD_GET_HOME_POSITION:     # MAVProxy asks every 2 s until answered
+            self._ack(c, mavlink.MAV_RESULT_ACCEPTED, gcs)
+            self._send(self._home_position())
+            return []
         if c == mavlink.MAV_CMD_SET_MESSAGE_INTERVAL:
             self._ack(c, self._set_interval(int(msg.param1), msg.param2), gcs)
             return []
@@ -280,10 +284,19 @@ class ShoreLink:
         return self.mav.autopilot_version_encode(CAPABILITIES, 0, 0, 0, 0, [0] * 8, [0] * 8,
                                                  [0] * 8, 0, 0, 0)
 
+    def _home_position(self):
+        """Home = the datum (odom's origin on the mean waterline): where the GCS draws H."""
+        d = self.settings.datum
+        return self.mav.home_position_encode(
+            int(round(d.latitude_deg * 1e7)), int(round(d.longitude_deg * 1e7)),
+            int(round(d.altitude_m * 1000)), 0.0, 0.0, 0.0, [1.0, 0.0, 0.0, 0.0], 0.0, 0.0, 0.0)
+
     def _request_message(self, msg_id: int, gcs) -> None:
-        if msg_id == mavlink.MAVLINK_MSG_ID_AUTOPILOT_VERSION:
+        once = {mavlink.MAVLINK_MSG_ID_AUTOPILOT_VERSION: self._autopilot_version,
+                mavlink.MAVLINK_MSG_ID_HOME_POSITION: self._home_position}
+        if msg_id in once:
             self._ack(mavlink.MAV_CMD_REQUEST_MESSAGE, mavlink.MAV_RESULT_ACCEPTED, gcs)
-            self._send(self._autopilot_version())
+            self._send(once[msg_id]())
             return
         streams = [name for name, sid in STREAM_IDS.items() if sid == msg_id]
         result = mavlink.MAV_RESULT_ACCEPTED if streams else mavlink.MAV_RESULT_UNSUPPORTED

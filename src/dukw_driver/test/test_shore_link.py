@@ -226,6 +226,24 @@ def test_connect_requests_and_unknown_commands_are_answered():
     assert link.scheduler.rates_hz['attitude'] == 2.0
 
 
+def test_home_position_is_the_datum_when_asked_either_way():
+    link, gcs = make_link(), Gcs()
+    link.receive(gcs.command(mavlink.MAV_CMD_GET_HOME_POSITION), 0.0)      # MAVProxy's way
+    link.receive(gcs.command(mavlink.MAV_CMD_REQUEST_MESSAGE,
+                             mavlink.MAVLINK_MSG_ID_HOME_POSITION), 0.0)    # the current way
+    gcs.feed(link.take_output())
+    datum = link.settings.datum
+    homes = gcs.of_type('HOME_POSITION')
+    assert len(homes) == 2
+    for home in homes:
+        assert home.latitude == round(datum.latitude_deg * 1e7)
+        assert home.longitude == round(datum.longitude_deg * 1e7)
+        assert home.altitude == round(datum.altitude_m * 1000)
+    results = {a.command: a.result for a in gcs.of_type('COMMAND_ACK')}
+    assert results == {mavlink.MAV_CMD_GET_HOME_POSITION: mavlink.MAV_RESULT_ACCEPTED,
+                       mavlink.MAV_CMD_REQUEST_MESSAGE: mavlink.MAV_RESULT_ACCEPTED}
+
+
 def test_param_protocol_serves_only_the_whitelist():
     link, gcs = make_link(), Gcs()
     link.receive(gcs.pack(gcs.mav.param_request_list_encode(1, 1)), 0.0)
