@@ -7,7 +7,8 @@ Prints per gain set and medium: RMS heading error, RMS speed error (request - su
 the number of sign changes of the yaw-rate error and of the propeller differential,
 how many times a second the propeller command swings by more than 20 %, and how
 often a propeller current drops by 10 A within 0.3 s (and how many of those drops come
-with a steady command: the simulator's thrust follows the stern's immersion).
+with a steady command: not the controller's doing; the simulator's thrust falls only as a
+propeller nears or leaves the surface).
 
     python benchmarks/bench_gains.py [--models land.yaml water.yaml] [--calm]
 """

@@ -26,6 +26,7 @@ import numpy as np
 
 from dukw_common.config import ParamValue, node_params
 from dukw_common.vehicle import SoilParams, Vehicle
+from dukw_driver.motors import prop_thrust_n
 from dukw_estimation import traction
 
 from dukw_sim.hull import HullGeometry, Seakeeping
@@ -35,7 +36,7 @@ from dukw_sim.truth import Medium, Truth
 from dukw_sim.world import (Beach, WaveModel, World, irregular_waves, no_waves,
                             regular_waves)
 
-__all__ = ['Actuation', 'SimCore', 'SimParams']
+__all__ = ['Actuation', 'SimCore', 'SimParams', 'propeller_thrust_factor']
 
 _ROLL_EPS_MPS = 0.005          # regularisation of Coulomb rolling resistance
 _FRICTION_EPS_MPS = 0.02       # of drivetrain friction
@@ -79,6 +80,21 @@ class Actuation:
 def _require_finite(what: str, *values: float) -> None:
     if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in values):
         raise ValueError(f'{what} must be finite numbers, got {values}')
+
+
+def propeller_thrust_factor(hub_depth_m: float, diameter_m: float,
+                            ventilation_depth_m: float) -> float:
+    """Share of its open-water thrust a propeller gives at this hub depth, 0..1.
+
+    The thrust follows the part of the propeller disc that works in solid water: the disc
+    below a plane ``ventilation_depth_m`` under the local surface (closer to the surface the
+    blades draw air). A propeller whose tip circle is deeper than that gives full thrust, a
+    half-emerged one about half, one out of the water none. Only the propeller's own depth
+    counts, not the hull's: a pitching hull loses no thrust while its propeller stays under.
+    """
+    radius_m = diameter_m / 2.0
+    h = min(max((hub_depth_m - ventilation_depth_m) / radius_m, -1.0), 1.0)
+    return (math.acos(-h) + h * math.sqrt(1.0 - h * h)) / math.pi
 
 
 def _soil_with_floor(soil: SoilParams, min_k_m: float) -> SoilParams:
@@ -134,15 +150,16 @@ class SimCore:
         s = vehicle.sensors
         n = self.hull.station_x_m.size
         self._n_stations = n
-        # body-frame sample points: hull strips, then base_link, fore, aft sensors, sounder
+        # body-frame sample points: hull strips, then base_link, fore, aft sensors, sounder,
+        # port and starboard propeller hubs (on the hulls' centrelines)
+        prop = params.propeller
         self._pts_x = np.concatenate([self.hull.station_x_m,
                                       [0.0, s.fore_water_x_m, s.aft_water_x_m,
-                                       s.depth_sounder_x_m]])
-        self._pts_y = np.concatenate([self.hull.station_y_m, [0.0, 0.0, 0.0, 0.0]])
+                                       s.depth_sounder_x_m, prop.x_m, prop.x_m]])
+        self._pts_y = np.concatenate([self.hull.station_y_m,
+                                      [0.0, 0.0, 0.0, 0.0, self._half_sep, -self._half_sep]])
         self._lat_s = [self._track_len * ((j + 0.5) / _LATERAL_POINTS - 0.5)
                        for j in range(_LATERAL_POINTS)]
-        self._stern_idx = (int(np.argmin(self.hull.station_x_m[:n // 2])),
-                           n // 2 + int(np.argmin(self.hull.station_x_m[n // 2:])))
         self._external = (0.0, 0.0, 0.0)
         self._hydro_key = None
         self._hydro_val = None
@@ -383,15 +400,14 @@ class SimCore:
                 Y += -s * down
         # water: propellers, drag, walk
         wat = p.water
-        d_float = self.seakeeping.equilibrium_depth_m
-        stern_imm = [min(max(float(depths[k]) / d_float, 0.0), 1.0) for k in self._stern_idx]
-        thrust = [self._thrust(act.port_prop_pct) * stern_imm[0],
-                  self._thrust(act.stbd_prop_pct) * stern_imm[1]]
+        prop_share = self._prop_thrust_factors(water.elevation_m)
+        thrust = [prop_thrust_n(act.port_prop_pct, drive) * prop_share[0],
+                  prop_thrust_n(act.stbd_prop_pct, drive) * prop_share[1]]
         X += thrust[0] + thrust[1]
         N += (thrust[1] - thrust[0]) * self._half_sep
         walk = -wat.prop_walk_ratio * (thrust[0] + thrust[1])
         Y += walk
-        N += walk * wat.prop_x_m
+        N += walk * p.propeller.x_m
         X -= (wat.surge_linear_drag_n_per_mps * u_rel
               + wat.surge_quadratic_drag_n_per_mps2 * abs(u_rel) * u_rel) * frac
         Y -= (wat.sway_linear_drag_n_per_mps * v_rel
@@ -579,11 +595,15 @@ class SimCore:
             return self.ref[i]
         return self.ref[i] - motor_force_n / loop_k      # afloat too: friction, paddling
 
-    def _thrust(self, pct: float) -> float:
-        """Propeller thrust for a command, N (reverse weaker, vehicle.md section 1)."""
-        drive = self.vehicle.drivetrain
-        t = drive.max_prop_thrust_n * pct / 100.0
-        return t if pct >= 0.0 else t * drive.prop_reverse_thrust_ratio
+    def _prop_thrust_factors(self, eta: np.ndarray) -> list[float]:
+        """Port and starboard thrust shares from each propeller's depth under the surface."""
+        prop = self.params.propeller
+        hub_z = (self.z_cg + prop.hub_z_m - self._kg - prop.x_m * math.sin(self.pitch))
+        n = self._n_stations
+        return [propeller_thrust_factor(
+                    float(eta[n + 4 + i]) - (hub_z + y * math.sin(self.roll)),
+                    prop.diameter_m, prop.ventilation_depth_m)
+                for i, y in enumerate((self._half_sep, -self._half_sep))]
 
     def _touchdown(self) -> None:
         """Land on the sand when a track end reaches it (an inelastic contact).

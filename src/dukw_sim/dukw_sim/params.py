@@ -103,7 +103,6 @@ class WaterParams:
     sway_quadratic_drag_n_per_mps2: float
     yaw_linear_drag_nm_per_rps: float
     yaw_quadratic_drag_nm_per_rps2: float
-    prop_x_m: float
     prop_walk_ratio: float
     prop_max_current_a: float
     track_paddle_coeff_n_per_mps2: float
@@ -140,6 +139,21 @@ class StartParams:
 
 
 @dataclass(frozen=True)
+class PropellerParams:
+    """Where each hull's propeller sits and how big it is (shared ``vehicle.propeller.*``)."""
+
+    x_m: float                   # hub in base_link, m (on each hull's centreline)
+    hub_z_m: float               # hub above the keel, m
+    diameter_m: float
+    ventilation_depth_m: float   # tip depth below which the propeller draws air, m
+
+    def __post_init__(self) -> None:
+        _positive(self, 'diameter_m')
+        if self.ventilation_depth_m < 0.0:
+            raise ConfigError('vehicle.propeller.ventilation_depth_m must be >= 0')
+
+
+@dataclass(frozen=True)
 class SimParams:
     """Everything the simulator core needs beyond the shared Vehicle."""
 
@@ -152,6 +166,7 @@ class SimParams:
     seakeeping: SeakeepingParams
     start: StartParams
     dry_soil: SoilParams | None
+    propeller: PropellerParams
 
     @classmethod
     def from_params(cls, params: Mapping[str, ParamValue]) -> 'SimParams':
@@ -166,7 +181,8 @@ class SimParams:
                   build_settings(LandParams, params, 'land'),
                   build_settings(WaterParams, params, 'water'),
                   build_settings(SeakeepingParams, params, 'seakeeping'),
-                  build_settings(StartParams, params, 'start'), dry)
+                  build_settings(StartParams, params, 'start'), dry,
+                  build_settings(PropellerParams, params, 'vehicle.propeller'))
         return out
 
 

@@ -7,7 +7,7 @@ import pytest
 
 from dukw_common.config import ConfigError
 from dukw_estimation.buoyancy import hull_volume_from_depths
-from dukw_sim.core import Actuation, SimCore
+from dukw_sim.core import Actuation, SimCore, propeller_thrust_factor
 from dukw_sim.truth import Medium, Truth
 
 WAVES = {'waves.model': 'irregular', 'waves.significant_height_m': 0.28}
@@ -163,6 +163,36 @@ def test_start_up_force_peaks_above_the_running_force():
     running = np.mean(forces[-100:])
     assert running > 0.0
     assert max(forces[:100]) > 1.8 * running
+
+
+def test_thrust_factor_follows_the_propeller_disc_in_solid_water():
+    assert propeller_thrust_factor(0.40, 0.25, 0.05) == 1.0
+    assert propeller_thrust_factor(0.05, 0.25, 0.05) == pytest.approx(0.5)
+    assert propeller_thrust_factor(-0.10, 0.25, 0.05) == 0.0
+    shares = [propeller_thrust_factor(d, 0.25, 0.05) for d in np.linspace(-0.07, 0.17, 25)]
+    assert np.all(np.diff(shares) > 0.0)
+
+
+def _thrust_after(pitch_rad: float = 0.0, heave_m: float = 0.0) -> float:
+    sim = SimCore.from_config()
+    sim.reset('afloat')
+    sim.perturb(heave_m=heave_m, pitch_rad=pitch_rad)
+    return sim.step(Actuation(0, 0, 60, 60)).port_thrust_n
+
+
+def test_thrust_holds_while_the_stern_rises_but_the_propeller_stays_under():
+    # bow down 0.1 rad: the hulls' sterns rise 0.13 m (half their immersion), the
+    # propellers stay well under: a steady command gives the same thrust as level
+    level = _thrust_after()
+    assert level == pytest.approx(0.6 * SimCore.from_config().vehicle.drivetrain.max_prop_thrust_n)
+    assert _thrust_after(pitch_rad=0.1) == pytest.approx(level)
+
+
+def test_thrust_drops_as_the_propeller_breaks_the_surface():
+    level = _thrust_after()
+    breaking = _thrust_after(heave_m=0.30)     # hub about at the surface
+    assert 0.2 * level < breaking < 0.8 * level
+    assert _thrust_after(heave_m=0.60) == 0.0  # the whole disc out of the water
 
 
 def test_propellers_afloat_only_and_reverse_is_weaker():
