@@ -2,7 +2,7 @@
 
 Runs config/mission.yaml (land -> sea -> land in the 28 cm sea) on the simulator core
 with the mode manager and drive controller cores closed around it (truth feedback, as
-src/dukw_control/test/closed_loop.py) and the mission's line-of-sight guidance at 20 Hz.
+dukw_bringup.stack_harness) and the mission's line-of-sight guidance at 20 Hz.
 Prints per gain set and medium: RMS heading error, RMS speed error (request - surge),
 the number of sign changes of the yaw-rate error and of the propeller differential,
 how many times a second the propeller command swings by more than 20 %, and how
@@ -16,18 +16,13 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / 'src/dukw_control/test'))
-
-from closed_loop import ClosedLoop, default_controller_settings  # noqa: E402
-
-from dukw_bringup.mission import LosGuidance, load_mission  # noqa: E402
-from dukw_bringup.run_setup import sim_overrides  # noqa: E402
-from dukw_common.geometry import wrap_angle  # noqa: E402
+from dukw_bringup.mission import LosGuidance, load_mission
+from dukw_bringup.run_setup import sim_overrides
+from dukw_bringup.stack_harness import ClosedLoop, default_controller_settings
+from dukw_common.geometry import wrap_angle
 
 GUIDANCE_EVERY = 5        # 100 Hz / 5 = mission_node's 20 Hz
 SWING_PCT = 20.0          # a propeller command step larger than this counts as a swing
