@@ -163,6 +163,10 @@ def run(args: argparse.Namespace, stop: threading.Event) -> int:
             print(f'[main_job] shore link: MAVLink 2 on {args.shore_url}, signed; key file '
                   f'{shore_key}, passphrase for QGroundControl / MAVProxy: {passphrase}',
                   flush=True)
+            if args.shore_url.startswith('udpout:'):    # the ground station listens there
+                print('[main_job] ground station: mavproxy.py --master=udpin:'
+                      f'{args.shore_url[len("udpout:"):]} '
+                      f'--cmd="set param_ftp 0; signing key {passphrase}"', flush=True)
         config_copy, overlay = prepare_run(run_dir, config, stack, mission, args.rtf,
                                            (shore_key, args.shore_url) if shore_key else None)
         runner = Runner(stack, [config_copy, overlay], log_dir=run_dir / 'logs', echo=False)
