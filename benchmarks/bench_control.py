@@ -7,6 +7,7 @@ import time
 
 from dukw_common.config import node_params
 from dukw_control import controller, modes
+from figures import report
 
 
 def timed(fn, n):
@@ -47,6 +48,7 @@ def main() -> None:
                      ('mode manager cycle (inputs + update)', mode_cycle)):
         median_us, p99_us = timed(fn, 20000)
         print(f'{name}: median {median_us:.1f} us, p99 {p99_us:.1f} us')
+        report(f'{name} median', median_us, 'us')
 
 
 if __name__ == '__main__':

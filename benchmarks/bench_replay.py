@@ -16,6 +16,7 @@ from pathlib import Path
 from dukw_bringup import bag_io
 from dukw_bringup.replay import replay, stream
 from dukw_bringup.replay_adapters import factories, missing
+from figures import report
 
 GOLDEN = Path(__file__).resolve().parents[1] / 'tests' / 'golden'
 
@@ -60,6 +61,8 @@ def main() -> None:
         for decode in (False, True):
             count, seconds = stream(bag, decode)
             label = 'decoded' if decode else 'raw'
+            report(f'replay streaming {label}', count / seconds, 'msg/s',
+                   target=None if decode else 100_000.0, better='higher')
             print(f'{label:<8}: {count} messages in {seconds:.3f} s = '
                   f'{count / seconds:,.0f} messages/s' + ('  (target >= 100,000)'
                                                           if not decode else ''))
@@ -80,6 +83,8 @@ def main() -> None:
         result = replay(bag, [f() for f in available.values()])
         print(f'cores   : {bag.name:<16} {"all together":<18} {result.messages:>7} messages in '
               f'{result.elapsed_s:.3f} s = {result.rate_msgs_per_s:,.0f} messages/s')
+        report(f'replay {bag.name} through all cores', result.rate_msgs_per_s, 'msg/s',
+               target=50_000.0, better='higher')
 
 
 if __name__ == '__main__':
