@@ -20,6 +20,7 @@ from dukw_driver.mavlink_imu import ImuSettings, MavlinkImuDecoder
 from dukw_driver.nmea_gps import GpsNmeaDecoder, NmeaGpsSettings
 from dukw_driver.nmea_stream import nmea_sentence
 from dukw_driver.numato_adc import NumatoAdc
+from figures import report
 
 UERE = UereSettings(4.0, 0.7)
 
@@ -63,6 +64,7 @@ def run(name: str, data: bytes, decode, repeat: int) -> None:
     cpu = time.process_time() - cpu
     print(f'{name:34s} {100.0 * cpu / repeat:6.2f} % of a core, '
           f'{count / cpu:9.0f} decoded/s CPU, {len(data):6d} B per device second')
+    report(f'decoder {name}', 100.0 * cpu / repeat, '% of a core')
 
 
 def main() -> None:

@@ -13,6 +13,7 @@ import argparse
 import subprocess
 import sys
 import time
+from figures import report as report_figure
 
 
 def endpoint(role: str, seconds: float) -> None:
@@ -41,6 +42,7 @@ def endpoint(role: str, seconds: float) -> None:
         if report:
             share = 100.0 * (time.process_time() - cpu0) / (time.monotonic() - wall0)
             print(f'  {role:<11} {share:5.1f} % of one core')
+            report_figure(f'rclpy floor, {role} endpoint at 100 Hz', share, '% of a core')
     rclpy.shutdown()
 
 
