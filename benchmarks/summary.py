@@ -54,16 +54,20 @@ def load_figures(path: Path) -> list[Figure]:
     return figures
 
 
+def _number(value: float) -> str:
+    return f'{value:,.0f}' if abs(value) >= 1e4 else f'{value:.4g}'
+
+
 def _bound(figure: Figure, bound: float | None) -> str:
     if bound is None:
         return ''
-    return f'{"<=" if figure.better == "lower" else ">="} {bound:g}'
+    return f'{"<=" if figure.better == "lower" else ">="} {_number(bound)}'
 
 
 def format_table(figures: list[Figure]) -> str:
     """The aligned plain-text table, one row per figure."""
     header = ('figure', 'value', 'unit', 'target', 'aim', 'status')
-    rows = [header] + [(f.name, f'{f.value:.4g}', f.unit, _bound(f, f.target),
+    rows = [header] + [(f.name, _number(f.value), f.unit, _bound(f, f.target),
                         _bound(f, f.aim), f.status()) for f in figures]
     widths = [max(len(row[i]) for row in rows) for i in range(len(header))]
     lines = ['  '.join(cell.rjust(w) if i == 1 else cell.ljust(w)

@@ -45,6 +45,7 @@ def test_report_appends_figure_lines_and_table_marks_met_and_not_met(tmp_path, m
     assert _row(table, 'p50').endswith('  met')
     assert _row(table, 'rtf').endswith('NOT met')
     assert '>= 100' in _row(table, 'rtf')
+    assert '60,000' in _row(table, 'replay') and '>= 50,000' in _row(table, 'replay')
     assert _row(table, 'replay').endswith('  met')
     assert _row(table, 'step').endswith('-')
     assert table.splitlines()[-1] == '3 of 5 targets met'
