@@ -52,7 +52,7 @@ PARSE_ERRORS = (mavlink.MAVError, struct.error, ValueError, IndexError, TypeErro
 
 @dataclass(frozen=True)
 class DriveCommand:
-    """Publish cmd_vel (geometry_msgs/Twist linear.x, angular.z)."""
+    """Publish cmd_vel (linear.x, angular.z; TwistStamped or Twist as cmd_vel_stamped says)."""
 
     speed_mps: float
     yaw_rate_rps: float
