@@ -15,7 +15,7 @@ from pathlib import Path
 
 from dukw_bringup import bag_io
 from dukw_bringup.replay import replay, stream
-from dukw_bringup.replay_adapters import factories, missing
+from dukw_bringup.replay_adapters import ADAPTERS
 from figures import report
 
 GOLDEN = Path(__file__).resolve().parents[1] / 'tests' / 'golden'
@@ -66,9 +66,7 @@ def main() -> None:
             print(f'{label:<8}: {count} messages in {seconds:.3f} s = '
                   f'{count / seconds:,.0f} messages/s' + ('  (target >= 100,000)'
                                                           if not decode else ''))
-    available = factories()
-    for name, why in sorted(missing().items()):
-        print(f'core {name}: not available ({why})')
+    available = ADAPTERS
     bags = sorted(p for p in GOLDEN.glob('*') if (p / 'metadata.yaml').is_file())
     if not available or not bags:
         print('through the cores: no golden bags or no core adapters yet')

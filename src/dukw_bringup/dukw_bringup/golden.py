@@ -2,25 +2,15 @@
 
     python -m dukw_bringup.golden --out tests/golden [--only land_circle]
 
-Each scenario runs the simulator's physics core (``dukw_sim.core.SimCore``), its sensor
-models and servo switch, the EKF (``Estimator``), the mode manager and the drive
-controller in one closed loop on the simulator's fixed step, with a fixed seed and a
-scripted ``cmd_vel``, and writes every topic those nodes exchange to an MCAP bag (zstd
-chunks). No DDS and no wall clock are involved, so the same code and config give the
-same bag byte for byte. The cores are driven through the very adapters the offline
-replay uses (``replay_adapters``), fed with the messages as decoded from their CDR
-bytes, on the nodes' timer grids with fixed offsets inside each step:
-
-    T        sensor messages of the step (stamped T), authority, cmd_vel (+0.1/0.2 ms)
-    0        robot_description and /tf_static (latched), as robot_state_node sends them
-    T+0.5 ms the EKF's output on the IMU sample: odometry/filtered (the controller steps
-             on it: tracks/cmd, props/cmd at +0.5 us), traction (+1 us), /tf (+2 us)
-    T+1 ms   ekf timer tick (publishes only while the IMU is silent)
-    T+2 ms   mode manager tick (every 5th step at 20 Hz): drive_mode on change or 1 s
-    T+3 ms   controller timer tick (if it steps): tracks/cmd, props/cmd -> servo switch;
-             the switch output drives the next physics step
-
-so replaying a golden bag reproduces its recorded outputs exactly (up to float noise).
+Each scenario runs the in-process stack (``dukw_bringup.stack_harness``: the simulator
+core, its sensor models and servo switch, and the EKF, mode manager and drive controller
+runners, each on its node's schedule) with a fixed seed and a scripted ``cmd_vel``, and
+writes every topic those nodes exchange to an MCAP bag (zstd chunks), robot_description
+and /tf_static at t = 0 as robot_state_node sends them. Every publication goes through
+its ROS message: the runners receive what a node decodes from the CDR bytes, so
+replaying a golden bag reproduces its recorded outputs exactly (up to float noise). No
+DDS and no wall clock are involved: the same code and config give the same bag byte for
+byte. The offsets within a step are the harness's (see stack_harness).
 """
 from __future__ import annotations
 
@@ -33,8 +23,9 @@ from pathlib import Path
 from typing import Callable, Sequence
 
 from dukw_bringup.bag_io import BagWriter, typestore
+from dukw_bringup.stack_harness import OFFSET_NS, SENSOR_TOPICS, ClosedLoop, CmdVel
 
-MS_NS = 1_000_000
+CMD_VEL_EVERY = 10        # the scripted cmd_vel comes at 10 Hz
 
 
 @dataclass(frozen=True)
@@ -73,173 +64,113 @@ SCENARIOS = {s.name: s for s in (
 )}
 
 
-class _Loop:
-    """The closed loop of one scenario, writing every exchanged message to ``writer``."""
+class BagWire:
+    """Carries each publication as its node would: the ROS message is built, serialised,
+    written to the bag, and what a subscriber decodes from it is handed over (through the
+    nodes' own conversions), so replaying the bag reproduces what the runners saw."""
 
-    def __init__(self, scenario: Scenario, writer: BagWriter,
-                 config_path: str | None) -> None:
+    def __init__(self, writer: BagWriter, config_path: str | None) -> None:
         from dukw_common.config import node_params
-        from dukw_sim.core import SimCore
-        from dukw_sim.sensors import SensorModel
-        from dukw_sim.switch import RcChannels, SimServoSwitch
-
-        from dukw_bringup.replay_adapters import (DriveControllerAdapter, EkfAdapter,
-                                                  ModeManagerAdapter)
-        self.scenario = scenario
-        self.writer = writer
-        self.config_path = config_path
-        self.store = typestore()
-        sim_params = node_params('sim_node', config_path)
-        self.cmd_vel_stamped = bool(sim_params['cmd_vel_stamped'])   # shared block
-        self.sim = SimCore.from_config(config_path, seed=scenario.seed)
-        self.sim.reset(x_m=scenario.start_x_m, yaw_rad=scenario.start_yaw_rad)
-        self.sensors = SensorModel.from_config(config_path, seed=scenario.seed)
-        self.switch = SimServoSwitch(float(sim_params['command_timeout_s']),
-                                     RcChannels.from_params(sim_params))
         from dukw_sim.sim_messages import Frames
-        self.frames = Frames(str(sim_params['frames.base']), str(sim_params['frames.imu']),
-                             str(sim_params['frames.gps']))
-        self.ekf = EkfAdapter(config_path)
-        self.modes = ModeManagerAdapter(config_path)
-        self.controller = DriveControllerAdapter(config_path)
-        self.republish_ns = round(float(
-            node_params('mode_manager_node', config_path)['republish_period_s']) * 1e9)
-        self.last_mode_ns: int | None = None
-        self.step_ns = round(self.sim.dt_s * 1e9)
-        for name, rate in (('ekf', self.ekf.rate_hz), ('controller', self.controller.rate_hz)):
-            if round(1e9 / rate) != self.step_ns:
-                raise ValueError(f'golden: {name} rate {rate} Hz must equal the sim step')
-        self.mode_every = round(1e9 / self.modes.rate_hz) // self.step_ns
-        self.last_authority_ns: int | None = None
-        self.ekf_pending: tuple | None = None
-        self.timeline: list[tuple[float, str]] = []
+        self.writer = writer
+        self.store = typestore()
+        params = node_params('sim_node', config_path)
+        self.cmd_vel_stamped = bool(params['cmd_vel_stamped'])    # shared block
+        self.frames = Frames(str(params['frames.base']), str(params['frames.imu']),
+                             str(params['frames.gps']))
+        self.last_odometry = None
 
-    # --- messages ------------------------------------------------------------------
-    def _emit(self, topic: str, t_ns: int, msg, consumers=()) -> None:
-        """Serialize ``msg`` (rclpy), write it, feed its decoded form to ``consumers``."""
+    def carry(self, topic: str, t_ns: int, item):
+        """Write ``item`` on ``topic`` at ``t_ns``; return it as the subscribers decode it."""
         from rclpy.serialization import serialize_message
+        msg = self.message(topic, t_ns, item)
         msgtype = type(msg).__module__.split('.')[0] + '/msg/' + type(msg).__name__
         # rclpy leaves CDR padding bytes uninitialised: re-encode with rosbags (zeroed) so
         # the bag is the same byte for byte on every run
         decoded = self.store.deserialize_cdr(serialize_message(msg), msgtype)
-        raw = self.store.serialize_cdr(decoded, msgtype)
         self.writer.add_topic('/' + topic, msgtype)
-        self.writer.write('/' + topic, t_ns, raw)
-        for adapter in consumers:
-            if topic in adapter.inputs:
-                out = adapter.feed(topic, t_ns * 1e-9, decoded)
-                if out is not None and adapter is self.controller:
-                    self._command(t_ns + 500, out)  # 0.5 us after its cause
-                elif out is not None and adapter is self.ekf:
-                    # built now (what the EKF knows after this IMU sample), written after
-                    # this step's other sensor messages
-                    self.ekf_pending = self._estimate_messages()
+        self.writer.write('/' + topic, t_ns, self.store.serialize_cdr(decoded, msgtype))
+        return self.received(topic, t_ns, decoded)
 
-    def _command(self, t_ns: int, out: dict[str, float]) -> None:
-        from dukw_common.node_tools import s_to_stamp
-        from dukw_control.convert import diff_command
-        from dukw_control.mixer import SidePair
-        stamp = s_to_stamp(t_ns * 1e-9)
-        for actuator in ('tracks', 'props'):
-            port, stbd = out[f'{actuator}.port_pct'], out[f'{actuator}.stbd_pct']
-            self._emit(f'{actuator}/cmd', t_ns, diff_command(SidePair(port, stbd), stamp))
-            self.switch.command(actuator, port, stbd, t_ns * 1e-9)
-
-    def _estimate_messages(self) -> tuple:
-        """odometry/filtered and traction as ekf_node would publish them now."""
-        from dukw_common.node_tools import s_to_stamp
-        from dukw_estimation.ros_convert import odometry_msg, traction_msg
-        from dukw_msgs.msg import Traction
-        est = self.ekf.core
-        stamp = s_to_stamp(est.t_s)
-        return (odometry_msg(est.odometry(), stamp, 'odom', 'base_link'),
-                traction_msg(est.traction(), stamp, Traction))
-
-    def _publish_estimates(self, t_ns: int, messages: tuple) -> None:
-        """As ekf_node: odometry, then traction and /tf (1 and 2 us later, in that order)."""
-        from dukw_common.tf_tools import odometry_tf
-        everyone = (self.ekf, self.modes, self.controller)
-        self._emit('odometry/filtered', t_ns, messages[0], everyone)
-        self._emit('traction', t_ns + 1_000, messages[1], everyone)
-        self._emit('tf', t_ns + 2_000, odometry_tf(messages[0]))
-
-    # --- one step --------------------------------------------------------------------
-    def step(self, k: int) -> None:
-        from dukw_common.node_tools import s_to_stamp
-        from dukw_control.convert import decision_to_msg
-        from dukw_sim import sim_messages as sm
-        from dukw_sim.core import Actuation
+    def message(self, topic: str, t_ns: int, item):
+        """The ROS message the publishing node sends for ``item``."""
         from dukw_common.cmd_vel import make_cmd_vel
-
-        t_prev_s = self.sim.t_s
-        out = self.switch.outputs(t_prev_s)
-        truth = self.sim.step(Actuation(out.tracks.port_pct, out.tracks.stbd_pct,
-                                        out.props.port_pct, out.props.stbd_pct))
-        t_ns = k * self.step_ns
-        everyone = (self.ekf, self.modes, self.controller)
-        for reading in self.sensors.sample(truth):
-            topic, msg = sm.fresh_reading(reading, self.frames)
-            self._emit(topic, t_ns, msg, everyone)
-        state = self.switch.state
-        if (self.switch.gate.changed or self.last_authority_ns is None
-                or t_ns - self.last_authority_ns >= 1_000 * MS_NS):
-            self.switch.gate.changed = False
-            self.last_authority_ns = t_ns
-            self._emit('authority', t_ns + MS_NS // 10, sm.fresh_authority(state, truth.t_s),
-                       everyone)
-        if k % 10 == 0:
-            speed, yaw_rate = self.scenario.cmd_vel(t_ns * 1e-9)
-            t_cmd_ns = t_ns + MS_NS // 5
-            self._emit('cmd_vel', t_cmd_ns, make_cmd_vel(self.cmd_vel_stamped, speed, yaw_rate,
-                                                         t_cmd_ns * 1e-9), everyone)
-        if self.ekf_pending is not None:           # the EKF published on the IMU sample
-            self._publish_estimates(t_ns + MS_NS // 2, self.ekf_pending)
-            self.ekf_pending = None
-        # ekf timer (publishes only while the IMU is silent)
-        t_ekf = t_ns + MS_NS
-        if self.ekf.tick(t_ekf * 1e-9) is not None:
-            self._publish_estimates(t_ekf, self._estimate_messages())
-        # mode manager (as mode_manager_node.on_timer)
-        if k % self.mode_every == 0:
-            t_mm = t_ns + 2 * MS_NS
-            self.modes.tick(t_mm * 1e-9)
-            core = self.modes.core
-            if core.changed or t_mm - self.last_mode_ns >= self.republish_ns:
-                decision = core.decision()
-                if core.changed:
-                    self.timeline.append((t_mm * 1e-9, decision.mode.name))
-                core.changed = False
-                self.last_mode_ns = t_mm
-                self._emit('drive_mode', t_mm, decision_to_msg(decision, s_to_stamp(
-                    t_mm * 1e-9)), everyone)
-        # controller timer (it may also have stepped on odometry above)
-        t_ctrl = t_ns + 3 * MS_NS
-        out = self.controller.tick(t_ctrl * 1e-9)
-        if out is not None:
-            self._command(t_ctrl, out)
-
-    def _describe(self) -> None:
-        """robot_description and /tf_static at t = 0, as robot_state_node."""
-        from dukw_common.config import node_params
-        from dukw_common.description import FrameNames, VehicleModel
         from dukw_common.node_tools import s_to_stamp
-        from dukw_common.tf_tools import tf_message
-        from dukw_common.vehicle import Vehicle
-        from std_msgs.msg import String
-        params = node_params('robot_state_node', self.config_path)
-        vehicle = Vehicle.from_params(params)
-        model = VehicleModel.build(vehicle.body, vehicle.sensors, FrameNames.from_params(params),
-                                   float(params['deck_thickness_m']))
-        self._emit('robot_description', 0, String(data=model.urdf()))
-        self._emit('tf_static', 0, tf_message(model.static_transforms(), s_to_stamp(0.0)))
+        from dukw_common.tf_tools import odometry_tf
+        from dukw_control.convert import decision_to_msg, diff_command
+        from dukw_estimation import ros_convert
+        from dukw_msgs.msg import Traction
+        from dukw_sim import sim_messages
+        t_s = t_ns * 1e-9
+        if topic in SENSOR_TOPICS:
+            return sim_messages.fresh_reading(item, self.frames)[1]
+        if topic == 'authority':      # stamped with the step's sim time, as sim_node does
+            return sim_messages.fresh_authority(item, (t_ns - OFFSET_NS['authority']) * 1e-9)
+        if topic == 'cmd_vel':
+            return make_cmd_vel(self.cmd_vel_stamped, item.speed_mps, item.yaw_rate_rps,
+                                item.stamp_s)
+        if topic == 'odometry/filtered':
+            self.last_odometry = ros_convert.odometry_msg(item, s_to_stamp(item.t_s), 'odom',
+                                                          'base_link')
+            return self.last_odometry
+        if topic == 'tf':
+            return odometry_tf(self.last_odometry)
+        if topic == 'traction':
+            return ros_convert.traction_msg(item, s_to_stamp(item.t_s), Traction)
+        if topic == 'drive_mode':
+            return decision_to_msg(item, s_to_stamp(t_s))
+        if topic in ('tracks/cmd', 'props/cmd'):
+            return diff_command(item, s_to_stamp(t_s))
+        return item                               # already a message (robot_description...)
 
-    def run(self) -> None:
-        self._describe()
-        steps = round(self.scenario.duration_s * 1e9 / self.step_ns)
-        for k in range(1, steps + 1):
-            self.step(k)
-        truth = self.sim.truth
-        self.final = (truth.x_m, truth.y_m, truth.medium.name)
+    @staticmethod
+    def received(topic: str, t_ns: int, msg):
+        """What a subscribing node makes of ``msg`` (the nodes' conversions)."""
+        from dukw_common.cmd_vel import read_cmd_vel
+        from dukw_control.convert import decision_from_msg
+        from dukw_estimation import ros_convert
+        if topic in SENSOR_TOPICS:
+            return ros_convert.SAMPLE_FROM_MSG[topic](msg, ros_convert.stamp_or(msg,
+                                                                                t_ns * 1e-9))
+        if topic == 'odometry/filtered':
+            return ros_convert.odometry_estimate(msg)
+        if topic == 'traction':
+            return ros_convert.traction_estimate(msg)
+        if topic == 'drive_mode':
+            return decision_from_msg(msg)
+        if topic == 'cmd_vel':
+            return CmdVel(*read_cmd_vel(msg))
+        return msg
+
+
+def _describe(wire: BagWire, config_path: str | None) -> None:
+    """robot_description and /tf_static at t = 0, as robot_state_node."""
+    from dukw_common.config import node_params
+    from dukw_common.description import FrameNames, VehicleModel
+    from dukw_common.node_tools import s_to_stamp
+    from dukw_common.tf_tools import tf_message
+    from dukw_common.vehicle import Vehicle
+    from std_msgs.msg import String
+    params = node_params('robot_state_node', config_path)
+    vehicle = Vehicle.from_params(params)
+    model = VehicleModel.build(vehicle.body, vehicle.sensors, FrameNames.from_params(params),
+                               float(params['deck_thickness_m']))
+    wire.carry('robot_description', 0, String(data=model.urdf()))
+    wire.carry('tf_static', 0, tf_message(model.static_transforms(), s_to_stamp(0.0)))
+
+
+def run(scenario: Scenario, writer: BagWriter, config_path: str | None = None) -> ClosedLoop:
+    """The scenario on the in-process stack, every publication through the bag."""
+    wire = BagWire(writer, config_path)
+    _describe(wire, config_path)
+    stack = ClosedLoop(seed=scenario.seed, x_m=scenario.start_x_m,
+                       yaw_rad=scenario.start_yaw_rad, feedback='ekf',
+                       estimator_knows_site=False, config=config_path, wire=wire)
+    steps = round(scenario.duration_s / stack.sim.dt_s)
+    for k in range(1, steps + 1):
+        t_s = k * stack.step_ns * 1e-9
+        stack.step(scenario.cmd_vel(t_s) if k % CMD_VEL_EVERY == 0 else None)
+    return stack
 
 
 def generate(scenario: Scenario, out_dir: Path, config_path: str | None = None) -> Path:
@@ -248,12 +179,12 @@ def generate(scenario: Scenario, out_dir: Path, config_path: str | None = None) 
     if bag.exists():
         shutil.rmtree(bag)
     with BagWriter(bag, compress=True, flush_period_s=None) as writer:   # same bytes each run
-        loop = _Loop(scenario, writer, config_path)
-        loop.run()
+        stack = run(scenario, writer, config_path)
     size_kb = sum(p.stat().st_size for p in bag.iterdir()) / 1024
-    modes = ' -> '.join(f'{name} ({t:.2f} s)' for t, name in loop.timeline)
+    modes = ' -> '.join(f'{mode.name} ({t:.2f} s)' for t, mode, _ in stack.record.modes)
+    truth = stack.sim.truth
     print(f'{scenario.name}: {sum(writer.counts.values())} messages, {size_kb:.0f} kB; '
-          f'ends at x={loop.final[0]:.2f} m y={loop.final[1]:.2f} m ({loop.final[2]}); '
+          f'ends at x={truth.x_m:.2f} m y={truth.y_m:.2f} m ({truth.medium.name}); '
           f'modes: {modes}')
     return bag
 

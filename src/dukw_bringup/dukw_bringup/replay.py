@@ -19,43 +19,12 @@ import csv
 import math
 import sys
 import time
-from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterable, Sequence
 
 from dukw_bringup.bag_io import BagError, deserialize, read_messages, topic_key, typestore
-
-
-class CoreAdapter(ABC):
-    """One node's core, driven from bag messages like its node would drive it."""
-
-    #: short name, e.g. 'mode_manager'
-    name: str = ''
-    #: topic keys (no leading slash) whose messages the node subscribes to
-    inputs: tuple[str, ...] = ()
-    #: topic keys of the outputs this adapter reproduces and compares
-    outputs: tuple[str, ...] = ()
-    #: the node's timer rate, Hz
-    rate_hz: float = 1.0
-    #: quantities that are angles, rad: compared modulo 2 pi
-    angle_quantities: frozenset[str] = frozenset()
-
-    @abstractmethod
-    def feed(self, topic: str, t_s: float, msg: Any) -> dict[str, float] | None:
-        """An input message received at ``t_s`` (bag time, s).
-
-        Return an output when the node reacts at once (outside its timer), else None.
-        """
-
-    @abstractmethod
-    def tick(self, t_s: float) -> dict[str, float] | None:
-        """The node's timer at ``t_s``: step the core and return its output as named
-        numbers, or None when the node skips this tick (publishes nothing)."""
-
-    @abstractmethod
-    def recorded(self, topic: str, msg: Any) -> dict[str, float]:
-        """The same named numbers from a recorded output message on ``topic``."""
+from dukw_bringup.replay_adapters import ADAPTERS, CoreAdapter
 
 
 @dataclass
@@ -206,9 +175,8 @@ def stream(bag: str | Path, decode: bool = False,
 
 
 def available_adapters() -> dict[str, Callable[[], CoreAdapter]]:
-    """Adapter factories by name, for every core that is importable."""
-    from dukw_bringup import replay_adapters
-    return replay_adapters.factories()
+    """Adapter factories by name."""
+    return dict(ADAPTERS)
 
 
 def write_csv(rows: list[dict[str, float]], path: Path) -> None:

@@ -1,7 +1,8 @@
 """drive_controller_node: cmd_vel -> tracks/cmd and props/cmd within the vehicle's limits.
 
-A thin shell around dukw_control.controller.DriveController: it converts messages,
-runs the core at ``rate_hz`` and publishes the commands (neutral on shutdown).
+A thin shell around dukw_control.runners.DriveControllerRunner (when to step) and
+dukw_control.controller.DriveController (what to command): it converts messages and
+publishes the commands (neutral on shutdown).
 """
 from diagnostic_msgs.msg import DiagnosticArray
 from dukw_msgs.msg import Authority, DrivetrainStatus, DriveMode, Traction
@@ -14,9 +15,10 @@ from dukw_common.config import ConfigError
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
                                     declare_parameters, diagnostic_array, publisher_sources,
                                     run_node, vehicle_specs)
-from dukw_control.controller import NODE_PARAMS, DriveController, settings_from_params
+from dukw_control.controller import NODE_PARAMS, ControlOutput
 from dukw_control.convert import (ActuatorPublishers, authority_usable, decision_from_msg,
                                   pitch_from_quaternion, stamp_or)
+from dukw_control.runners import DriveControllerRunner
 
 
 class DriveControllerNode(Node):
@@ -30,9 +32,10 @@ class DriveControllerNode(Node):
         params = declare_parameters(self, specs + vehicle_specs('vehicle', 'drivetrain',
                                                                 'limits'))
         try:
-            self.core = DriveController(settings_from_params(params))
+            self.runner = DriveControllerRunner.from_params(params)
         except ValueError as exc:
             raise ConfigError(f'drive_controller_node: {exc}') from exc
+        self.core = self.runner.core
         self.commands = ActuatorPublishers(self, COMMAND_QOS)
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
         self.create_subscription(cmd_vel_type(params['cmd_vel_stamped']), 'cmd_vel',
@@ -46,10 +49,7 @@ class DriveControllerNode(Node):
         self.create_subscription(DrivetrainStatus, 'props/status', self.on_props, SENSOR_QOS)
         self.props_connected = None
         self.last_reason = None
-        self.step_on_odometry = bool(params['step_on_odometry'])
-        self.period_s = 1.0 / params['rate_hz']
-        self.last_event_step_s = -1.0
-        self.create_timer(self.period_s, self.on_tick)
+        self.create_timer(self.runner.period_s, self.on_tick)
         self.create_timer(params['diagnostics_period_s'], self.publish_diagnostics)
 
     def now_s(self) -> float:
@@ -59,49 +59,44 @@ class DriveControllerNode(Node):
     def on_cmd_vel(self, msg) -> None:
         """geometry_msgs/TwistStamped (its stamp ages it) or Twist, as cmd_vel_stamped says."""
         speed_mps, yaw_rate_rps, stamp_s = read_cmd_vel(msg)
-        if not self.core.on_cmd_vel(speed_mps, yaw_rate_rps, self.now_s(), stamp_s):
+        if not self.runner.on_cmd_vel(speed_mps, yaw_rate_rps, self.now_s(), stamp_s):
             self.get_logger().warn(f'cmd_vel rejected: {self.core.i.last_rejection}',
                                    throttle_duration_sec=1.0)
 
     def on_authority(self, msg: Authority) -> None:
         self.core.sources.update('authority', *publisher_sources(self, 'authority'))
-        usable, detail = authority_usable(msg)
-        self.core.on_authority(usable, detail, self.now_s())
-        if not usable:
-            self.on_timer()          # neutral at once, not at the next tick
+        self.publish(self.runner.on_authority(*authority_usable(msg), self.now_s()))
 
     def on_mode(self, msg: DriveMode) -> None:
         self.core.sources.update('drive_mode', *publisher_sources(self, 'drive_mode'))
-        self.core.on_mode(decision_from_msg(msg), self.now_s())
+        self.runner.on_mode(decision_from_msg(msg), self.now_s())
 
     def on_odometry(self, msg: Odometry) -> None:
-        now = self.now_s()
-        self.core.on_odometry(msg.twist.twist.linear.x, msg.twist.twist.angular.z, now)
-        self.core.on_pitch(pitch_from_quaternion(msg.pose.pose.orientation), now)
-        if self.step_on_odometry:
-            self.last_event_step_s = now
-            self.on_timer()
+        self.publish(self.runner.on_odometry(
+            msg.twist.twist.linear.x, msg.twist.twist.angular.z,
+            pitch_from_quaternion(msg.pose.pose.orientation), self.now_s()))
 
     def on_imu(self, msg: Imu) -> None:
         now = self.now_s()
-        self.core.on_attitude(stamp_or(msg, now), now)
+        self.runner.on_imu(stamp_or(msg, now), now)
 
     def on_tick(self) -> None:
-        if self.now_s() - self.last_event_step_s >= 1.5 * self.period_s:
-            self.on_timer()          # the estimator is silent: keep the guards running
+        self.publish(self.runner.tick(self.now_s()))
 
     def on_traction(self, msg: Traction) -> None:
-        self.core.on_slips(msg.port_slip, msg.stbd_slip, self.now_s())
+        self.runner.on_traction(msg.port_slip, msg.stbd_slip, self.now_s())
 
     def on_tracks(self, msg: DrivetrainStatus) -> None:
-        if msg.connected:            # a silent controller goes stale, and the tracks stop
-            self.core.on_track_currents(msg.port.current_a, msg.stbd.current_a, self.now_s())
+        self.runner.on_track_status(msg.connected, msg.port.current_a, msg.stbd.current_a,
+                                    self.now_s())
 
     def on_props(self, msg: DrivetrainStatus) -> None:
         self.props_connected = msg.connected
 
-    def on_timer(self) -> None:
-        out = self.core.step(self.now_s())
+    def publish(self, out: ControlOutput | None) -> None:
+        """Publish a step's commands (None: the runner did not step)."""
+        if out is None:
+            return
         self.commands.publish(out.tracks, out.props)
         if out.neutral_reason != self.last_reason:
             self.last_reason = out.neutral_reason

@@ -1,8 +1,9 @@
 """mode_manager_node: decides LAND / TRANSITION / WATER / SAFE_STOP and publishes drive_mode.
 
-A thin shell around dukw_control.modes.ModeManager: drive_mode (transient local)
-on every change with its reason and every ``republish_period_s``; the service
-``set_mode`` forces a mode or returns to automatic.
+A thin shell around dukw_control.runners.ModeManagerRunner (the schedule: drive_mode,
+transient local, on every change with its reason and every ``republish_period_s``) and
+dukw_control.modes.ModeManager (the decision); the service ``set_mode`` forces a mode
+or returns to automatic.
 """
 from diagnostic_msgs.msg import DiagnosticArray
 from dukw_msgs.msg import Depth, DrivetrainStatus, DriveMode, Traction, WaterContact
@@ -17,7 +18,8 @@ from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpe
                                     declare_parameters, diagnostic_array, refuse_second_client,
                                     run_node)
 from dukw_control.convert import decision_to_msg, stamp_or
-from dukw_control.modes import NODE_PARAMS, Mode, ModeManager, settings_from_params
+from dukw_control.modes import NODE_PARAMS, Mode
+from dukw_control.runners import ModeManagerRunner
 
 
 class ModeManagerNode(Node):
@@ -28,12 +30,11 @@ class ModeManagerNode(Node):
         specs = [ParamSpec(n, d, min=lo, max=hi) for n, d, lo, hi in NODE_PARAMS]
         params = declare_parameters(self, specs)
         try:
-            self.core = ModeManager(settings_from_params(params))
+            self.runner = ModeManagerRunner.from_params(params)
         except ValueError as exc:
             raise ConfigError(f'mode_manager_node: {exc}') from exc
-        self.republish_period_s = params['republish_period_s']
+        self.core = self.runner.core
         self.sources = SourceWatch()          # set_mode: one client, the operator's
-        self.last_publish_s = -1e9
         self.mode_pub = self.create_publisher(DriveMode, 'drive_mode', STATE_QOS)
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
         self.create_subscription(WaterContact, 'water/contact', self.on_contact, SENSOR_QOS)
@@ -42,7 +43,7 @@ class ModeManagerNode(Node):
         self.create_subscription(DrivetrainStatus, 'tracks/status', self.on_tracks, SENSOR_QOS)
         self.create_subscription(Imu, 'imu/data', self.on_imu, SENSOR_QOS)
         self.create_service(SetMode, 'set_mode', self.on_set_mode)
-        self.create_timer(1.0 / params['rate_hz'], self.on_timer)
+        self.create_timer(1.0 / self.runner.rate_hz, self.on_timer)
         self.create_timer(1.0, self.publish_diagnostics)
 
     def now_s(self) -> float:
@@ -50,21 +51,21 @@ class ModeManagerNode(Node):
         return self.get_clock().now().nanoseconds * 1e-9
 
     def on_contact(self, msg: WaterContact) -> None:
-        self.core.on_water_contact(msg.fore_wet, msg.aft_wet, self.now_s())
+        self.runner.on_water_contact(msg.fore_wet, msg.aft_wet, self.now_s())
 
     def on_depth(self, msg: Depth) -> None:
-        self.core.on_depth(msg.valid, msg.depth_m, self.now_s())
+        self.runner.on_depth(msg.valid, msg.depth_m, self.now_s())
 
     def on_traction(self, msg: Traction) -> None:
-        self.core.on_traction(msg.weight_on_tracks_fraction, self.now_s())
+        self.runner.on_traction(msg.weight_on_tracks_fraction, self.now_s())
 
     def on_tracks(self, msg: DrivetrainStatus) -> None:
-        if msg.connected:
-            self.core.on_track_forces(msg.port.force_n, msg.stbd.force_n, self.now_s())
+        self.runner.on_track_status(msg.connected, msg.port.force_n, msg.stbd.force_n,
+                                    self.now_s())
 
     def on_imu(self, msg: Imu) -> None:
         now = self.now_s()
-        self.core.on_attitude(stamp_or(msg, now), now)
+        self.runner.on_imu(stamp_or(msg, now), now)
 
     def on_set_mode(self, request: SetMode.Request, response: SetMode.Response):
         refusal = refuse_second_client(self, self.sources, 'set_mode', self.publish_diagnostics)
@@ -89,14 +90,13 @@ class ModeManagerNode(Node):
         return response
 
     def on_timer(self) -> None:
-        now = self.now_s()
-        decision = self.core.update(now)
-        if self.core.changed or now - self.last_publish_s >= self.republish_period_s:
-            if self.core.changed:
-                self.get_logger().info(f'drive mode {decision.mode.name}: {decision.reason}')
-            self.core.changed = False
-            self.last_publish_s = now
-            self.mode_pub.publish(decision_to_msg(decision, self.get_clock().now().to_msg()))
+        publication = self.runner.tick(self.now_s())
+        if publication is None:
+            return
+        decision = publication.decision
+        if publication.changed:
+            self.get_logger().info(f'drive mode {decision.mode.name}: {decision.reason}')
+        self.mode_pub.publish(decision_to_msg(decision, self.get_clock().now().to_msg()))
 
     def publish_diagnostics(self) -> None:
         now = self.now_s()

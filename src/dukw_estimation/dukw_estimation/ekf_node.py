@@ -3,7 +3,8 @@
 Subscribes (sensor QoS) imu/data, gps/fix, gps/vel, water/contact, depth, tracks/status,
 props/status; publishes odometry/filtered (odom -> base_link; also on /tf with
 ``publish_tf``, as robot_localization), traction and /diagnostics;
-serves set_pose (dukw_msgs/srv/SetPose). All the work is in dukw_estimation.estimator.
+serves set_pose (dukw_msgs/srv/SetPose). The schedule (when the estimate goes out) is
+dukw_estimation.runner's, the estimation dukw_estimation.estimator's.
 """
 from __future__ import annotations
 
@@ -23,16 +24,15 @@ from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, ParamSpec, declare_
                                     s_to_stamp, vehicle_specs)
 from dukw_common.sources import SourceWatch
 from dukw_common.tf_tools import TF_QOS, odometry_tf
-from dukw_common.vehicle import Vehicle, soil_params
 from dukw_estimation import ros_convert as conv
-from dukw_estimation.estimator import Estimator
-from dukw_estimation.settings import EkfSettings, setting_specs
+from dukw_estimation.runner import EkfRunner, Estimate
+from dukw_estimation.settings import setting_specs
 
 DIAGNOSTICS_PERIOD_S = 1.0
 
 
 class EkfNode(Node):
-    """Thin shell around Estimator: messages in, estimates out at rate_hz."""
+    """Thin shell around EkfRunner: messages in, estimates out."""
 
     def __init__(self, **node_kwargs) -> None:
         super().__init__('ekf_node', **node_kwargs)
@@ -45,63 +45,48 @@ class EkfNode(Node):
                   for name in section(node_params('ekf_node'), 'soil_presets')
                   if name != 'names']
         params = declare_parameters(self, specs)
-        self.settings = EkfSettings.from_params(params)
-        self.publish_on_imu = bool(params['publish_on_imu'])
-        self.last_event_publish_s = -1.0
+        self.runner = EkfRunner.from_params(params)
+        self.estimator = self.runner.estimator
         self.sources = SourceWatch()               # set_pose: one client, the operator's
-        soil = soil_params(params, self.settings.soil_preset or None)
-        self.estimator = Estimator(Vehicle.from_params(params), self.settings, soil)
         self.odom_pub = self.create_publisher(Odometry, 'odometry/filtered', COMMAND_QOS)
         self.traction_pub = self.create_publisher(Traction, 'traction', COMMAND_QOS)
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
         self.tf_pub = (self.create_publisher(TFMessage, '/tf', TF_QOS)
                        if params['publish_tf'] else None)
-        est = self.estimator
-        for msg_type, topic, convert, add in (
-                (Imu, 'imu/data', conv.imu_sample, est.add_imu),
-                (NavSatFix, 'gps/fix', conv.gps_fix, est.add_gps_fix),
-                (TwistWithCovarianceStamped, 'gps/vel', conv.gps_velocity,
-                 est.add_gps_velocity),
-                (WaterContact, 'water/contact', conv.water_contact, est.add_water_contact),
-                (Depth, 'depth', conv.depth, est.add_depth),
-                (DrivetrainStatus, 'tracks/status', conv.drive_status, est.add_tracks),
-                (DrivetrainStatus, 'props/status', conv.drive_status, est.add_props)):
-            self.create_subscription(msg_type, topic, self._handler(convert, add), SENSOR_QOS)
+        for msg_type, topic in ((Imu, 'imu/data'), (NavSatFix, 'gps/fix'),
+                                (TwistWithCovarianceStamped, 'gps/vel'),
+                                (WaterContact, 'water/contact'), (Depth, 'depth'),
+                                (DrivetrainStatus, 'tracks/status'),
+                                (DrivetrainStatus, 'props/status')):
+            self.create_subscription(msg_type, topic, self._handler(topic), SENSOR_QOS)
         self.create_service(SetPose, 'set_pose', self._on_set_pose)
-        self.create_timer(1.0 / self.settings.rate_hz, self._on_timer)
+        self.create_timer(1.0 / self.runner.rate_hz, self._on_timer)
         self.create_timer(DIAGNOSTICS_PERIOD_S, self._on_diagnostics)
 
     def _now_s(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
 
-    def _handler(self, convert, add):
-        publish = self.publish_on_imu and add == self.estimator.add_imu
+    def _handler(self, topic: str):
+        convert = conv.SAMPLE_FROM_MSG[topic]
 
         def callback(msg) -> None:
             now = self._now_s()
-            add(convert(msg, conv.stamp_or(msg, now)))
-            if publish and self.estimator.t_s is not None:
-                self.last_event_publish_s = now
-                self._publish()
+            self._publish(self.runner.on_sample(topic, convert(msg, conv.stamp_or(msg, now)),
+                                                now))
         return callback
 
     def _on_timer(self) -> None:
-        est = self.estimator
-        now = self._now_s()
-        if est.t_s is None or now - self.last_event_publish_s < 1.5 / self.settings.rate_hz:
-            return  # nothing measured yet, or the IMU drives the output
-        if 0.0 < now - est.t_s <= self.settings.sensor_timeout_s:
-            est.advance(now)  # predict to the present, never further than a timeout
-        self._publish()
+        self._publish(self.runner.tick(self._now_s()))
 
-    def _publish(self) -> None:
-        est = self.estimator
-        stamp = s_to_stamp(est.t_s)
-        odom = conv.odometry_msg(est.odometry(), stamp, 'odom', 'base_link')
+    def _publish(self, estimate: Estimate | None) -> None:
+        if estimate is None:
+            return
+        stamp = s_to_stamp(estimate.t_s)
+        odom = conv.odometry_msg(estimate.odometry, stamp, 'odom', 'base_link')
         self.odom_pub.publish(odom)
         if self.tf_pub is not None:
             self.tf_pub.publish(odometry_tf(odom))
-        self.traction_pub.publish(conv.traction_msg(est.traction(), stamp, Traction))
+        self.traction_pub.publish(conv.traction_msg(estimate.traction, stamp, Traction))
 
     def _on_diagnostics(self) -> None:
         healths = self.estimator.health(self._now_s())

@@ -67,6 +67,18 @@ def drive_status(msg, t_s: float) -> DriveStatus:
     return DriveStatus(t_s, side(msg.port), side(msg.stbd), bool(msg.connected))
 
 
+#: the float fields of dukw_msgs/Traction (named as in TractionEstimate)
+TRACTION_FIELDS = ('port_slip', 'stbd_slip', 'submerged_volume_m3', 'effective_weight_n',
+                   'weight_on_tracks_fraction', 'waterline_distance_m', 'submerged_length_m',
+                   'slope_rad', 'port_force_predicted_n', 'stbd_force_predicted_n',
+                   'port_force_measured_n', 'stbd_force_measured_n')
+
+#: subscribed topic -> its message -> sample conversion (ekf_node, replay, golden bags)
+SAMPLE_FROM_MSG = {'imu/data': imu_sample, 'gps/fix': gps_fix, 'gps/vel': gps_velocity,
+                   'water/contact': water_contact, 'depth': depth,
+                   'tracks/status': drive_status, 'props/status': drive_status}
+
+
 def odometry_msg(est: OdometryEstimate, stamp, frame_id: str, child_frame_id: str) -> Odometry:
     """OdometryEstimate -> nav_msgs/Odometry (pose in odom, twist in base_link)."""
     msg = Odometry()
@@ -84,15 +96,30 @@ def odometry_msg(est: OdometryEstimate, stamp, frame_id: str, child_frame_id: st
     return msg
 
 
+def odometry_estimate(msg) -> OdometryEstimate:
+    """nav_msgs/Odometry -> OdometryEstimate (what a subscriber of odometry/filtered reads)."""
+    pose, twist = msg.pose.pose, msg.twist.twist
+    q = pose.orientation
+    roll, pitch, yaw = euler_from_quaternion(q.x, q.y, q.z, q.w)
+    return OdometryEstimate(stamp_to_s(msg.header.stamp), pose.position.x, pose.position.y,
+                            pose.position.z, roll, pitch, yaw, twist.linear.x, twist.linear.y,
+                            twist.angular.z, np.reshape(msg.pose.covariance, (6, 6)),
+                            np.reshape(msg.twist.covariance, (6, 6)))
+
+
+def traction_estimate(msg) -> TractionEstimate:
+    """dukw_msgs/Traction -> TractionEstimate."""
+    return TractionEstimate(stamp_to_s(msg.header.stamp),
+                            **{name: float(getattr(msg, name)) for name in TRACTION_FIELDS},
+                            afloat=bool(msg.afloat))
+
+
 def traction_msg(est: TractionEstimate, stamp, msg_type):
     """TractionEstimate -> dukw_msgs/Traction."""
     msg = msg_type()
     msg.header.stamp = stamp
     msg.header.frame_id = 'base_link'
-    for name in ('port_slip', 'stbd_slip', 'submerged_volume_m3', 'effective_weight_n',
-                 'weight_on_tracks_fraction', 'waterline_distance_m', 'submerged_length_m',
-                 'slope_rad', 'port_force_predicted_n', 'stbd_force_predicted_n',
-                 'port_force_measured_n', 'stbd_force_measured_n'):
+    for name in TRACTION_FIELDS:
         setattr(msg, name, float(getattr(est, name)))
     msg.afloat = bool(est.afloat)
     return msg

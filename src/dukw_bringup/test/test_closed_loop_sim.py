@@ -1,14 +1,14 @@
 """The control cores closed around the simulator core. Requirements of issue 6.
 
-Feedback 'truth' (the simulator's ground truth) or 'ekf' (the simulator's sensor
-models through the estimator core, as the nodes would see them); closed_loop.py.
+Feedback 'truth' (the simulator's ground truth as the estimate) or 'ekf' (the simulator's
+sensor models through the EKF runner, as the nodes see them); dukw_bringup.stack_harness.
 """
 import math
 
 import numpy as np
 import pytest
 
-from closed_loop import ClosedLoop
+from dukw_bringup.stack_harness import ClosedLoop
 from dukw_control.limits import CurrentState
 from dukw_control.modes import Mode
 
@@ -16,8 +16,6 @@ FLAT_SAND = {'world.flat_start_x_m': -60.0}
 
 
 def closed_loop(*args, feedback='truth', **kwargs):
-    if feedback == 'ekf':   # the estimator's offline adapter (dukw_estimation, issue 5)
-        pytest.importorskip('dukw_estimation.evaluate')
     return ClosedLoop(*args, feedback=feedback, **kwargs)
 
 

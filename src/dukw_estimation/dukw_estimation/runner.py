@@ -1,0 +1,93 @@
+"""ekf_node's schedule, ROS-free: what it does on each input and on each timer tick.
+
+ekf_node, the offline replay (replay_adapters), the golden-bag generator and the
+in-process stack harness (dukw_bringup.stack_harness) all drive this runner, so the
+estimator's timing rule lives here and nowhere else:
+
+- every sensor sample goes to the estimator as it arrives;
+- with ``publish_on_imu`` the estimate goes out after each IMU sample (the IMU's rate is
+  the output rate: the controller steps on it), and the ``rate_hz`` timer publishes only
+  while the IMU has been silent for 1.5 periods, predicting to the present but never
+  further than ``sensor_timeout_s`` past the last sample.
+
+The estimate is read through pure queries (odometry(), traction()): asking for it changes
+nothing.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+from dukw_common.config import ParamValue
+from dukw_common.vehicle import Vehicle, soil_params
+from dukw_estimation.estimator import Estimator
+from dukw_estimation.samples import OdometryEstimate, TractionEstimate
+from dukw_estimation.settings import EkfSettings
+
+#: the timer publishes when the IMU has been silent this many periods
+SILENT_PERIODS = 1.5
+
+#: subscribed topic -> the estimator's input method
+INPUTS = {'imu/data': 'add_imu', 'gps/fix': 'add_gps_fix', 'gps/vel': 'add_gps_velocity',
+          'water/contact': 'add_water_contact', 'depth': 'add_depth',
+          'tracks/status': 'add_tracks', 'props/status': 'add_props'}
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """What ekf_node publishes at once: odometry/filtered (and /tf) and traction."""
+
+    odometry: OdometryEstimate
+    traction: TractionEstimate
+
+    @property
+    def t_s(self) -> float:
+        return self.odometry.t_s
+
+
+class EkfRunner:
+    """ekf_node's schedule around dukw_estimation.estimator.Estimator."""
+
+    def __init__(self, estimator: Estimator, settings: EkfSettings,
+                 publish_on_imu: bool) -> None:
+        self.estimator = estimator
+        self.settings = settings
+        self.rate_hz = float(settings.rate_hz)
+        self.period_s = 1.0 / self.rate_hz
+        self.publish_on_imu = bool(publish_on_imu)
+        self.last_event_publish_s = -float('inf')
+        self._routes = {topic: getattr(estimator, name) for topic, name in INPUTS.items()}
+
+    @classmethod
+    def from_params(cls, params: Mapping[str, ParamValue], vehicle: Vehicle | None = None,
+                    settings: EkfSettings | None = None) -> 'EkfRunner':
+        """As ekf_node configures it; ``vehicle``/``settings`` override the parameters'
+        (the harness hands the simulator's survey datum, a campaign a mismatched beach)."""
+        settings = settings or EkfSettings.from_params(params)
+        estimator = Estimator(vehicle or Vehicle.from_params(params), settings,
+                              soil_params(params, settings.soil_preset or None))
+        return cls(estimator, settings, bool(params.get('publish_on_imu', False)))
+
+    def on_sample(self, topic: str, sample: Any, now_s: float) -> Estimate | None:
+        """A converted sample of subscribed ``topic``; the estimate when it goes out now."""
+        add = self._routes.get(topic)
+        if add is None:
+            raise ValueError(f'ekf: no input {topic!r}; inputs are {sorted(INPUTS)}')
+        add(sample)
+        if topic != 'imu/data' or not self.publish_on_imu or self.estimator.t_s is None:
+            return None
+        self.last_event_publish_s = now_s
+        return self.estimate()
+
+    def tick(self, now_s: float) -> Estimate | None:
+        """The timer: publish only while the IMU is silent (and once something arrived)."""
+        est = self.estimator
+        if est.t_s is None or now_s - self.last_event_publish_s < SILENT_PERIODS * self.period_s:
+            return None
+        if 0.0 < now_s - est.t_s <= self.settings.sensor_timeout_s:
+            est.advance(now_s)       # predict to the present, never further than a timeout
+        return self.estimate()
+
+    def estimate(self) -> Estimate:
+        """The current estimate (pure: asking changes nothing)."""
+        return Estimate(self.estimator.odometry(), self.estimator.traction())
