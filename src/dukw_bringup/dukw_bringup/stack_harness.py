@@ -21,7 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from dukw_common.config import node_params
-from dukw_common.geometry import euler_from_quaternion
+from dukw_common.readings import DepthReading, DriveStatus, ImuSample, WaterContact
 from dukw_control import controller, modes
 from dukw_control.controller import ControllerSettings, DriveController
 from dukw_control.modes import ModeManager, ModeSettings
@@ -68,7 +68,7 @@ class ClosedLoop:
         self.truth = self.sim.reset(start, x_m, yaw_rad)
         self.feedback = feedback
         if feedback == 'ekf':
-            from dukw_estimation.evaluate import SensorAdapter, build_estimator
+            from dukw_estimation.evaluate import build_estimator
             from dukw_sim.sensors import SensorModel
             self.sensors = SensorModel.from_config(seed=seed)
             gps = self.sensors.config.gps
@@ -78,7 +78,6 @@ class ClosedLoop:
                 vehicle = Vehicle.from_params(node_params('ekf_node'))
             self.est = build_estimator(vehicle, (gps.datum_lat_deg, gps.datum_lon_deg,
                                                  gps.datum_alt_m))
-            self.adapter = SensorAdapter(self.est)
         self.sensor_filter = sensor_filter
         self.estimate = None
         self.gate = CommandGate(node_params('sim_node')['command_timeout_s'])
@@ -146,22 +145,23 @@ class ClosedLoop:
             m.on_track_forces(tr.port_current_a * self.gain, tr.stbd_current_a * self.gain, t)
 
     def _feed_sensors(self, t: float) -> None:
+        from dukw_estimation.feed import feed
         c, m = self.ctrl, self.modes
         readings = self.sensors.sample(self.truth)
         if self.sensor_filter is not None:
             readings = self.sensor_filter(readings)
         for reading in readings:
-            self.adapter.feed(reading)
-            kind = type(reading).__name__
-            if kind == 'ImuReading':
-                c.on_pitch(euler_from_quaternion(*reading.orientation_xyzw)[1], t)
+            feed(self.est, reading)
+            if isinstance(reading, ImuSample):
+                c.on_pitch(reading.pitch_rad, t)
                 c.on_attitude(t, t)
                 m.on_attitude(t, t)
-            elif kind == 'WaterContactReading':
+            elif isinstance(reading, WaterContact):
                 m.on_water_contact(reading.fore_wet, reading.aft_wet, t)
-            elif kind == 'DepthReading':
+            elif isinstance(reading, DepthReading):
                 m.on_depth(reading.valid, reading.depth_m, t)
-            elif kind == 'DrivetrainReading' and reading.drive == 'tracks' and reading.connected:
+            elif (isinstance(reading, DriveStatus) and reading.drive == 'tracks'
+                  and reading.connected):
                 c.on_track_currents(reading.port.current_a, reading.stbd.current_a, t)
                 m.on_track_forces(reading.port.force_n, reading.stbd.force_n, t)
         if self.est.t_s is None:
