@@ -107,6 +107,8 @@ def test_every_reading_of_the_sensor_model_survives_the_round_trip():
 def test_a_drive_status_must_say_its_drive():
     with pytest.raises(ValueError, match='drive'):
         SimMessages(FRAMES).reading(DriveStatus(1.0, SIDE, SIDE))
+    with pytest.raises(ValueError, match='drive'):
+        DriveStatus(1.0, SIDE, SIDE, True, 'paddles')
 
 
 def test_the_estimator_sees_the_same_in_process_and_over_ros():

@@ -112,3 +112,7 @@ class DriveStatus:
     stbd: MotorSide
     connected: bool = True
     drive: str = ''
+
+    def __post_init__(self) -> None:
+        if self.drive not in ('',) + DRIVES:
+            raise ValueError(f'drive must be one of {DRIVES} (or empty), got {self.drive!r}')
