@@ -19,7 +19,7 @@ from dukw_common.geometry import geodetic_from_local_enu
 from dukw_common.vehicle import Vehicle, soil_params
 from dukw_estimation.ekf import N_STATES, Idx
 from dukw_estimation.estimator import Estimator
-from dukw_estimation.samples import DriveStatus, GpsFix, GpsVelocity, ImuSample, MotorSide
+from dukw_common.readings import DriveStatus, GpsFix, GpsVelocity, ImuSample, MotorSide
 from dukw_estimation.settings import EkfSettings
 from figures import report
 

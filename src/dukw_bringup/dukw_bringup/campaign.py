@@ -334,7 +334,7 @@ def simulate(spec: Spec, cond: Mapping[str, Any]) -> tuple[np.ndarray, list, Any
         loop.step(cmd)
         if loop.estimate is None:
             continue
-        _, odo, trc = loop.estimate
+        odo, trc = loop.estimate.odometry, loop.estimate.traction
         tracks, props = loop.record.tracks[-1], loop.record.props[-1]
         mode_now = loop.record.modes[-1][1] if loop.record.modes else -1
         rows.append((before.t_s, before.x_m, before.y_m, before.yaw_rad, odo.x_m, odo.y_m,

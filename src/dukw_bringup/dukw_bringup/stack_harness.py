@@ -35,8 +35,7 @@ from dukw_control.runners import DriveControllerRunner, ModeManagerRunner, ModeP
 from dukw_estimation.runner import EkfRunner, Estimate
 from dukw_estimation.samples import OdometryEstimate, TractionEstimate
 from dukw_control.convert import authority_usable
-from dukw_estimation import samples as est_samples
-from dukw_common.geometry import euler_from_quaternion
+from dukw_common.readings import reading_topic
 from dukw_sim.core import Actuation, SimCore
 from dukw_sim.sensors import SensorModel
 from dukw_sim.switch import RcChannels, SimServoSwitch
@@ -62,11 +61,10 @@ class CmdVel:
 
 
 class DirectWire:
-    """Publications handed over as objects (no messages); a sensor reading as the
-    estimator's sample."""
+    """Publications handed over as objects (no messages)."""
 
     def carry(self, topic: str, t_ns: int, item: Any) -> Any:
-        return reading_sample(item)[1] if topic in SENSOR_TOPICS else item
+        return item
 
 
 @dataclass
@@ -108,41 +106,6 @@ class TruthOracle:
             tr.port_force_n, tr.stbd_force_n, tr.port_force_n, tr.stbd_force_n,
             not tr.in_ground_contact, tr.wave_elevation_m)
         return Estimate(odom, traction)
-
-
-def reading_topic(r) -> str:
-    """The topic a simulator reading goes out on."""
-    kind = type(r).__name__
-    if kind == 'DrivetrainReading':
-        return f'{r.drive}/status'
-    return {'ImuReading': 'imu/data', 'GpsFix': 'gps/fix', 'GpsVelocity': 'gps/vel',
-            'WaterContactReading': 'water/contact', 'DepthReading': 'depth'}[kind]
-
-
-def reading_sample(r) -> tuple[str, Any]:
-    """A simulator reading -> (topic, the estimator's sample)."""
-    kind = type(r).__name__
-    if kind == 'ImuReading':
-        roll, pitch, yaw = euler_from_quaternion(*r.orientation_xyzw)
-        w, a = r.angular_velocity_rps, r.linear_acceleration_mps2
-        return 'imu/data', est_samples.ImuSample(r.t_s, roll, pitch, yaw, w[0], w[1], w[2],
-                                                 a[0], a[1], a[2], r.orientation_var[2],
-                                                 r.angular_velocity_var[2])
-    if kind == 'GpsFix':
-        return 'gps/fix', est_samples.GpsFix(r.t_s, r.latitude_deg, r.longitude_deg,
-                                             r.altitude_m, r.position_var[0])
-    if kind == 'GpsVelocity':
-        v = r.velocity_enu_mps
-        return 'gps/vel', est_samples.GpsVelocity(r.t_s, v[0], v[1], r.velocity_var[0])
-    if kind == 'WaterContactReading':
-        return 'water/contact', est_samples.WaterContact(r.t_s, r.fore_wet, r.aft_wet)
-    if kind == 'DepthReading':
-        return 'depth', est_samples.DepthReading(r.t_s, r.valid, r.depth_m)
-
-    def side(m) -> est_samples.MotorSide:
-        return est_samples.MotorSide(m.command_pct, m.current_a, m.speed_mps, m.force_n)
-    return f'{r.drive}/status', est_samples.DriveStatus(r.t_s, side(r.port), side(r.stbd),
-                                                        r.connected)
 
 
 def default_controller_settings() -> ControllerSettings:

@@ -172,15 +172,15 @@ def test_campaign_on_a_given_scheduler_address(twice, tmp_path):
 
 
 def test_gps_faults_drop_fixes_in_the_window_and_throw_one_outlier():
-    from dukw_sim.sensors import GpsFix, GpsVelocity
+    from dukw_common.readings import GpsFix, GpsVelocity
     cond = {'gps_dropout': True, 'gps_dropout_start_s': 1.0, 'gps_dropout_duration_s': 0.5,
             'gps_outlier': True, 'gps_outlier_start_s': 2.0, 'gps_outlier_offset_m': 10.0}
     faults = campaign.SensorFaults(cond)
 
     def fix(t):
-        return GpsFix(t, 36.0, -75.0, 0.0, (0.1, 0.1, 0.2))
+        return GpsFix(t, 36.0, -75.0, 0.0, 0.1, True, 0.2)
 
-    assert faults([fix(1.2), GpsVelocity(1.2, (1.0, 0.0, 0.0), (0.1, 0.1, 0.1))]) == []
+    assert faults([fix(1.2), GpsVelocity(1.2, 1.0, 0.0, 0.1, 0.0, 0.1)]) == []
     assert faults([fix(1.5)]) == [fix(1.5)]
     moved = faults([fix(2.0)])[0]
     north_m = math.radians(moved.latitude_deg - 36.0) * campaign.EARTH_RADIUS_M

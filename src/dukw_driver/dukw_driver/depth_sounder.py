@@ -26,8 +26,9 @@ TEMP_MAX_AGE_S = 10.0
 
 
 @dataclass(frozen=True)
-class DepthReading:
-    """One dukw_msgs/Depth worth of data."""
+class SounderDepth:
+    """One dukw_msgs/Depth worth of data as the decoder gives it (before stamping; the
+    published reading: dukw_common.readings.DepthReading)."""
 
     valid: bool
     depth_m: float         # NaN when not valid
@@ -36,7 +37,7 @@ class DepthReading:
 
 
 class DepthSounderDecoder:
-    """Bytes from the sounder in, DepthReading out; never raises on bad input."""
+    """Bytes from the sounder in, SounderDepth out; never raises on bad input."""
 
     def __init__(self, min_depth_m: float) -> None:
         if not finite(min_depth_m) or min_depth_m < 0:
@@ -50,7 +51,7 @@ class DepthSounderDecoder:
         self._temp_c = math.nan
         self._temp_time_s = -math.inf
 
-    def feed(self, data: bytes, now_s: float) -> list[DepthReading]:
+    def feed(self, data: bytes, now_s: float) -> list[SounderDepth]:
         """Decode received bytes at time ``now_s``."""
         return self.stream.decode(data, now_s, self._handlers)
 
@@ -58,14 +59,14 @@ class DepthSounderDecoder:
         """The last water temperature if recent, else NaN."""
         return self._temp_c if now_s - self._temp_time_s <= TEMP_MAX_AGE_S else math.nan
 
-    def _on_dpt(self, dpt, now_s: float) -> DepthReading:
+    def _on_dpt(self, dpt, now_s: float) -> SounderDepth:
         offset = _number(dpt.offset) if dpt.offset not in (None, '') else 0.0
         depth = _number(dpt.depth) if dpt.depth not in (None, '') else None
         self._offset_m = offset
         self._last_dpt_s = now_s
         return self._reading(depth, now_s)
 
-    def _on_dbt(self, dbt, now_s: float) -> DepthReading | None:
+    def _on_dbt(self, dbt, now_s: float) -> SounderDepth | None:
         if now_s - self._last_dpt_s < DPT_PREFERRED_S:
             return None
         if dbt.depth_meters not in (None, ''):
@@ -86,11 +87,11 @@ class DepthSounderDecoder:
             raise ValueError(f'water temperature {temp} degC out of range')
         self._temp_c, self._temp_time_s = temp, now_s
 
-    def _reading(self, depth_m: float | None, now_s: float) -> DepthReading:
+    def _reading(self, depth_m: float | None, now_s: float) -> SounderDepth:
         if depth_m is not None and depth_m < 0:
             raise ValueError(f'negative depth {depth_m}')
         valid = depth_m is not None and depth_m >= self.min_depth_m
-        return DepthReading(valid, depth_m if valid else math.nan, self._offset_m,
+        return SounderDepth(valid, depth_m if valid else math.nan, self._offset_m,
                             self.water_temp_c(now_s))
 
 

@@ -38,8 +38,9 @@ class GnssSource(str, Enum):
 
 
 @dataclass(frozen=True)
-class GpsFix:
-    """One position fix."""
+class GnssFix:
+    """One position fix as a receiver's decoder gives it (before stamping; the estimator's
+    reading of the published fix is dukw_common.readings.GpsFix)."""
 
     source: GnssSource
     status: FixStatus
@@ -51,8 +52,9 @@ class GpsFix:
 
 
 @dataclass(frozen=True)
-class GpsVelocity:
-    """Velocity over ground in ENU, m/s, with diagonal variances (m/s)^2."""
+class GnssVelocity:
+    """Velocity over ground in ENU, m/s, with diagonal variances (m/s)^2, as a receiver's
+    decoder gives it (the published reading: dukw_common.readings.GpsVelocity)."""
 
     source: GnssSource
     east_mps: float
@@ -81,13 +83,13 @@ def dop_covariance(hdop: float, status: FixStatus, uere: UereSettings) -> tuple:
 
 
 def velocity_from_course(speed_mps: float, course_deg: float, variance_mps2: float,
-                         source: GnssSource) -> GpsVelocity:
+                         source: GnssSource) -> GnssVelocity:
     """Speed and course over ground (clockwise from true north) -> ENU velocity.
 
     The vertical speed is unknown: reported 0 with a huge variance.
     """
     course = math.radians(course_deg)
-    return GpsVelocity(source, speed_mps * math.sin(course), speed_mps * math.cos(course), 0.0,
+    return GnssVelocity(source, speed_mps * math.sin(course), speed_mps * math.cos(course), 0.0,
                        (variance_mps2, variance_mps2, 1.0e6))
 
 

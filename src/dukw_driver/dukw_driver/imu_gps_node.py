@@ -16,9 +16,9 @@ from sensor_msgs.msg import Imu, NavSatFix, NavSatStatus
 from dukw_common.node_tools import (SENSOR_QOS, ParamSpec, declare_parameters, diagnostic_array,
                                     run_node)
 from dukw_driver.device_channel import DeviceChannel, link_from_params, require_name
-from dukw_driver.gnss import (FixStatus, GpsFix, GpsVelocity, SourcePreference, UereSettings,
+from dukw_driver.gnss import (FixStatus, GnssFix, GnssVelocity, SourcePreference, UereSettings,
                               parse_source)
-from dukw_driver.mavlink_imu import ImuSample, ImuSettings, MavlinkImuDecoder
+from dukw_driver.mavlink_imu import DecodedImu, ImuSettings, MavlinkImuDecoder
 from dukw_driver.nmea_gps import GpsNmeaDecoder, NmeaGpsSettings
 from dukw_driver.serial_link import DeviceHealth
 
@@ -86,16 +86,16 @@ class ImuGpsNode(Node):
         stamp = self.get_clock().now().to_msg()
         for device in self.devices:
             for item in device.poll(now_s):
-                if isinstance(item, ImuSample):
+                if isinstance(item, DecodedImu):
                     self.imu_pub.publish(self._imu(item, stamp))
-                elif isinstance(item, GpsFix) and self.fix_pref.accept(
+                elif isinstance(item, GnssFix) and self.fix_pref.accept(
                         item.source, now_s, usable=item.status != FixStatus.NO_FIX):
                     self.fix_pub.publish(self._fix(item, stamp))
-                elif isinstance(item, GpsVelocity) and self.vel_pref.accept(
+                elif isinstance(item, GnssVelocity) and self.vel_pref.accept(
                         item.source, now_s, usable=item.valid) and item.valid:
                     self.vel_pub.publish(self._vel(item, stamp))
 
-    def _imu(self, s: ImuSample, stamp) -> Imu:
+    def _imu(self, s: DecodedImu, stamp) -> Imu:
         msg = Imu()
         msg.header.stamp, msg.header.frame_id = stamp, self.imu_frame
         o, w = msg.orientation, msg.angular_velocity
@@ -109,7 +109,7 @@ class ImuGpsNode(Node):
         msg.linear_acceleration_covariance = list(s.linear_acceleration_covariance)
         return msg
 
-    def _fix(self, f: GpsFix, stamp) -> NavSatFix:
+    def _fix(self, f: GnssFix, stamp) -> NavSatFix:
         msg = NavSatFix()
         msg.header.stamp, msg.header.frame_id = stamp, self.gps_frame
         msg.status = NavSatStatus(status=int(f.status), service=NavSatStatus.SERVICE_GPS)
@@ -120,7 +120,7 @@ class ImuGpsNode(Node):
         msg.position_covariance_type = int(f.covariance_kind)
         return msg
 
-    def _vel(self, v: GpsVelocity, stamp) -> TwistWithCovarianceStamped:
+    def _vel(self, v: GnssVelocity, stamp) -> TwistWithCovarianceStamped:
         msg = TwistWithCovarianceStamped()
         msg.header.stamp, msg.header.frame_id = stamp, self.gps_frame
         lin = msg.twist.twist.linear

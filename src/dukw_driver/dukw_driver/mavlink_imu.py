@@ -7,7 +7,7 @@ clockwise from north). Everything leaving this module is ROS: ENU world, FLU bod
 Messages used:
 
 - ``ATTITUDE_QUATERNION`` (preferred once seen) or ``ATTITUDE``: orientation and
-  body rates. Each one yields an ``ImuSample``, with the latest acceleration.
+  body rates. Each one yields an ``DecodedImu``, with the latest acceleration.
 - ``HIGHRES_IMU`` (m/s^2), else ``SCALED_IMU``, else ``RAW_IMU`` (both taken as
   milli-g, as ArduPilot and PX4 fill them): the specific force (at rest +g on
   the FLU z axis). A lower-priority source is ignored once a better one is seen.
@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 from pymavlink.dialects.v20 import common as mavlink
 
 from dukw_common.geometry import frd_to_flu, ned_to_enu, quaternion_from_euler, yaw_ned_to_enu
-from dukw_driver.gnss import (CovarianceKind, FixStatus, GnssSource, GpsFix, GpsVelocity,
+from dukw_driver.gnss import (CovarianceKind, FixStatus, GnssSource, GnssFix, GnssVelocity,
                               UereSettings, dop_covariance, finite)
 
 STANDARD_GRAVITY_MPS2 = 9.80665
@@ -92,8 +92,9 @@ class ImuSettings:
 
 
 @dataclass(frozen=True)
-class ImuSample:
-    """One sensor_msgs/Imu worth of data in ENU/FLU; covariances row-major 3x3.
+class DecodedImu:
+    """One sensor_msgs/Imu worth of data in ENU/FLU, as decoded (the published reading:
+    dukw_common.readings.ImuSample); covariances row-major 3x3.
 
     ``linear_acceleration_flu_mps2`` is None when no recent acceleration came:
     then the message marks it unknown (covariance[0] = -1, REP 145).
@@ -129,11 +130,11 @@ class MavlinkCounters:
         return self.frame_errors + self.parse_errors
 
 
-Decoded = ImuSample | GpsFix | GpsVelocity
+Decoded = DecodedImu | GnssFix | GnssVelocity
 
 
 class MavlinkImuDecoder:
-    """Bytes from the IMU in, ImuSample / GpsFix / GpsVelocity out; never raises on bad input."""
+    """Bytes from the IMU in, DecodedImu / GnssFix / GnssVelocity out; never raises."""
 
     def __init__(self, settings: ImuSettings) -> None:
         self.settings = settings
@@ -224,8 +225,8 @@ class MavlinkImuDecoder:
         parser.robust_parsing = True
         return parser
 
-    # --- attitude -> ImuSample
-    def _on_attitude(self, msg, now_s: float) -> ImuSample | None:
+    # --- attitude -> DecodedImu
+    def _on_attitude(self, msg, now_s: float) -> DecodedImu | None:
         if self._use_quaternion:
             self.counters.ignored += 1
             return None
@@ -234,7 +235,7 @@ class MavlinkImuDecoder:
             raise ValueError('attitude not finite')
         return self._sample(orientation_enu_flu_from_euler_ned(*angles), msg, now_s)
 
-    def _on_attitude_quaternion(self, msg, now_s: float) -> ImuSample:
+    def _on_attitude_quaternion(self, msg, now_s: float) -> DecodedImu:
         q = (msg.q2, msg.q3, msg.q4, msg.q1)  # MAVLink q1 is w
         norm = math.sqrt(sum(c * c for c in q)) if finite(*q) else math.nan
         if not abs(norm - 1.0) < 0.1:
@@ -243,7 +244,7 @@ class MavlinkImuDecoder:
         q = tuple(c / norm for c in q)
         return self._sample(orientation_enu_flu_from_ned_frd(q), msg, now_s)
 
-    def _sample(self, orientation: tuple, msg, now_s: float) -> ImuSample:
+    def _sample(self, orientation: tuple, msg, now_s: float) -> DecodedImu:
         rates = (msg.rollspeed, msg.pitchspeed, msg.yawspeed)
         if not finite(*rates):
             raise ValueError('body rates not finite')
@@ -252,7 +253,7 @@ class MavlinkImuDecoder:
         accel_covariance = diagonal3(tuple(a ** 2 for a in s.accel_std_mps2))
         if accel is None:
             accel_covariance = (-1.0,) + (0.0,) * 8
-        return ImuSample(orientation, frd_to_flu(*rates), accel,
+        return DecodedImu(orientation, frd_to_flu(*rates), accel,
                          diagonal3(tuple(a ** 2 for a in s.orientation_std_rad)),
                          diagonal3((s.gyro_std_rps ** 2,) * 3), accel_covariance)
 
@@ -283,14 +284,14 @@ class MavlinkImuDecoder:
         self._accel_time_s = now_s
 
     # --- GPS
-    def _on_gps_raw_int(self, msg, _now_s: float) -> GpsFix:
+    def _on_gps_raw_int(self, msg, _now_s: float) -> GnssFix:
         if msg.vel_acc > 0:
             self._velocity_variance = (msg.vel_acc / 1000.0) ** 2
         status = GPS_FIX_STATUS.get(msg.fix_type, FixStatus.NO_FIX)
         self._gps_has_fix = status != FixStatus.NO_FIX
         if status == FixStatus.NO_FIX:
             nan = math.nan
-            return GpsFix(GnssSource.MAVLINK, status, nan, nan, nan, (0.0, 0.0, 0.0),
+            return GnssFix(GnssSource.MAVLINK, status, nan, nan, nan, (0.0, 0.0, 0.0),
                           CovarianceKind.UNKNOWN)
         latitude, longitude = msg.lat * 1e-7, msg.lon * 1e-7
         if abs(latitude) > 90 or abs(longitude) > 180:
@@ -304,11 +305,11 @@ class MavlinkImuDecoder:
             kind = CovarianceKind.APPROXIMATED
         else:
             covariance, kind = (0.0, 0.0, 0.0), CovarianceKind.UNKNOWN
-        return GpsFix(GnssSource.MAVLINK, status, latitude, longitude, altitude, covariance,
+        return GnssFix(GnssSource.MAVLINK, status, latitude, longitude, altitude, covariance,
                       kind)
 
-    def _on_global_position_int(self, msg, _now_s: float) -> GpsVelocity:
+    def _on_global_position_int(self, msg, _now_s: float) -> GnssVelocity:
         east, north, up = ned_to_enu(msg.vx / 100.0, msg.vy / 100.0, msg.vz / 100.0)
         variance = self._velocity_variance
-        return GpsVelocity(GnssSource.MAVLINK, east, north, up, (variance,) * 3,
+        return GnssVelocity(GnssSource.MAVLINK, east, north, up, (variance,) * 3,
                            valid=self._gps_has_fix)

@@ -14,10 +14,11 @@ from rclpy.node import Node
 from std_msgs.msg import Header
 
 from dukw_common.diagnostics import Level
+from dukw_common.readings import MotorSide as MotorReading
 from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, ParamSpec, declare_parameters,
                                     diagnostic_array, run_node, vehicle_specs)
 from dukw_common.vehicle import drivetrain_params
-from dukw_driver.motors import UNKNOWN_SIDE, Drive, MotorMonitor, SideStatus
+from dukw_driver.motors import UNKNOWN_SIDE, Drive, MotorMonitor
 from dukw_driver.roboteq import FAULT_FLAG_BITS, QUERIES
 from dukw_driver.serial_link import DeviceHealth, SerialLink
 
@@ -49,7 +50,7 @@ class MotorControllerNode(Node):
                                    expected_rate_hz=p['rate_hz'] * len(QUERIES))
         self.status_pub = self.create_publisher(DrivetrainStatus, f'{name}/status', SENSOR_QOS)
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
-        self.last: tuple[SideStatus, SideStatus] = (UNKNOWN_SIDE, UNKNOWN_SIDE)
+        self.last: tuple[MotorReading, MotorReading] = (UNKNOWN_SIDE, UNKNOWN_SIDE)
         self.create_timer(1.0 / p['rate_hz'], self.on_tick)
         self.create_timer(1.0, self.on_diagnostics)
 
@@ -72,7 +73,7 @@ class MotorControllerNode(Node):
             port=self._side(port), stbd=self._side(stbd)))
 
     @staticmethod
-    def _side(side: SideStatus) -> MotorSide:
+    def _side(side: MotorReading) -> MotorSide:
         return MotorSide(command_pct=side.command_pct, current_a=side.current_a,
                          voltage_v=side.voltage_v, speed_mps=side.speed_mps,
                          force_n=side.force_n, temperature_c=side.temperature_c,

@@ -18,10 +18,10 @@ current x gain (8.16 N/A, vehicle.md section 3). Propellers: no encoder, speed
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from enum import Enum
 
 from dukw_common.config import ConfigError
+from dukw_common.readings import MotorSide
 from dukw_common.vehicle import DrivetrainParams
 from dukw_driver.roboteq import (CONFIG_QUERIES, FAULT_COMM_TIMEOUT, QUERIES, ReplyParser,
                                  config_frame, decode_faults, decode_status, query_frame)
@@ -55,22 +55,10 @@ def prop_thrust_n(command_pct: float, drivetrain: DrivetrainParams) -> float:
     return drivetrain.max_prop_thrust_n * ratio * command_pct / 100.0
 
 
-@dataclass(frozen=True)
-class SideStatus:
-    """One motor channel as dukw_msgs/MotorSide carries it."""
-
-    command_pct: float
-    current_a: float
-    voltage_v: float
-    speed_mps: float
-    force_n: float
-    temperature_c: float
-    fault_flags: int
-    faults: tuple[str, ...]
-
-
-UNKNOWN_SIDE = SideStatus(math.nan, math.nan, math.nan, math.nan, math.nan, math.nan,
-                          FAULT_COMM_TIMEOUT, ('comm_timeout',))
+#: A channel the controller does not answer for (one motor channel: readings.MotorSide).
+UNKNOWN_SIDE = MotorSide(math.nan, math.nan, math.nan, math.nan, voltage_v=math.nan,
+                         temperature_c=math.nan, fault_flags=FAULT_COMM_TIMEOUT,
+                         faults=('comm_timeout',))
 
 
 class MotorMonitor:
@@ -118,7 +106,7 @@ class MotorMonitor:
         """Bytes to send this cycle: the runtime queries, and the watchdog until it is known."""
         return query_frame() + (config_frame() if self.watchdog_ms is None else b'')
 
-    def sides(self, now_s: float) -> tuple[SideStatus, SideStatus]:
+    def sides(self, now_s: float) -> tuple[MotorSide, MotorSide]:
         """(port, stbd) status now."""
         if not self.fresh(now_s):
             return UNKNOWN_SIDE, UNKNOWN_SIDE
@@ -133,8 +121,10 @@ class MotorMonitor:
             else:
                 speed, force = 0.0, prop_thrust_n(command_pct, self.drivetrain)
             report = decode_faults(v['FF'][0], v['FM'][index])
-            out.append(SideStatus(command_pct, current_a, v['V'][1] / 10.0, speed, force,
-                                  float(v['T'][1 + index]), report.flags, report.names))
+            out.append(MotorSide(command_pct, current_a, speed, force,
+                                 voltage_v=v['V'][1] / 10.0,
+                                 temperature_c=float(v['T'][1 + index]),
+                                 fault_flags=report.flags, faults=report.names))
         return out[0], out[1]
 
     def warnings(self) -> list[str]:

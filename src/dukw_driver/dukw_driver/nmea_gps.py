@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from dukw_driver.gnss import (CovarianceKind, FixStatus, GnssSource, GpsFix, GpsVelocity,
+from dukw_driver.gnss import (CovarianceKind, FixStatus, GnssSource, GnssFix, GnssVelocity,
                               UereSettings, dop_covariance, finite, velocity_from_course)
 from dukw_driver.nmea_stream import NmeaStream
 
@@ -42,7 +42,7 @@ class NmeaGpsSettings:
 
 
 class GpsNmeaDecoder:
-    """Bytes from the DGPS in, GpsFix and GpsVelocity out; never raises on bad input."""
+    """Bytes from the DGPS in, GnssFix and GnssVelocity out; never raises on bad input."""
 
     def __init__(self, settings: NmeaGpsSettings) -> None:
         self.settings = settings
@@ -59,16 +59,16 @@ class GpsNmeaDecoder:
         self.stream.reset()
         self._gst = None
 
-    def feed(self, data: bytes, now_s: float) -> list[GpsFix | GpsVelocity]:
+    def feed(self, data: bytes, now_s: float) -> list[GnssFix | GnssVelocity]:
         """Decode received bytes at time ``now_s``."""
         return self.stream.decode(data, now_s, self._handlers)
 
-    def _on_gga(self, gga, now_s: float) -> GpsFix:
+    def _on_gga(self, gga, now_s: float) -> GnssFix:
         quality = gga.gps_qual
         status = GGA_STATUS.get(quality if quality is not None else 0, FixStatus.NO_FIX)
         if status == FixStatus.NO_FIX:
             nan = math.nan
-            return GpsFix(GnssSource.NMEA, status, nan, nan, nan, (0.0, 0.0, 0.0),
+            return GnssFix(GnssSource.NMEA, status, nan, nan, nan, (0.0, 0.0, 0.0),
                           CovarianceKind.UNKNOWN)
         if not gga.lat or not gga.lon:
             raise ValueError('fix without a position')
@@ -78,7 +78,7 @@ class GpsNmeaDecoder:
                 longitude) > 180:
             raise ValueError('position out of range')
         covariance, kind = self._covariance(gga, status, now_s)
-        return GpsFix(GnssSource.NMEA, status, latitude, longitude, altitude, covariance, kind)
+        return GnssFix(GnssSource.NMEA, status, latitude, longitude, altitude, covariance, kind)
 
     def _covariance(self, gga, status: FixStatus, now_s: float) -> tuple:
         if self._gst is not None and now_s - self._gst[3] <= self.settings.gst_max_age_s:
@@ -97,7 +97,7 @@ class GpsNmeaDecoder:
             raise ValueError('GST without usable standard deviations')
         self._gst = (*(float(s) for s in stds), now_s)
 
-    def _on_vtg(self, vtg, now_s: float) -> GpsVelocity | None:
+    def _on_vtg(self, vtg, now_s: float) -> GnssVelocity | None:
         self._last_vtg_s = now_s
         if getattr(vtg, 'faa_mode', '') in INVALID_MODES or \
                 now_s - self._rmc_void_s < VTG_PREFERRED_S:
@@ -110,7 +110,7 @@ class GpsNmeaDecoder:
             return None
         return self._velocity(speed, vtg.true_track)
 
-    def _on_rmc(self, rmc, now_s: float) -> GpsVelocity | None:
+    def _on_rmc(self, rmc, now_s: float) -> GnssVelocity | None:
         if rmc.status != 'A' or getattr(rmc, 'mode_indicator', '') in INVALID_MODES:
             self._rmc_void_s = now_s
             return None
@@ -121,7 +121,7 @@ class GpsNmeaDecoder:
             return None
         return self._velocity(float(rmc.spd_over_grnd) * KNOT_MPS, rmc.true_course)
 
-    def _velocity(self, speed_mps: float, course_deg) -> GpsVelocity | None:
+    def _velocity(self, speed_mps: float, course_deg) -> GnssVelocity | None:
         if not finite(speed_mps) or speed_mps < 0:
             raise ValueError('bad speed over ground')
         if course_deg is None:

@@ -15,7 +15,7 @@ from rclpy.node import Node
 from dukw_common.config import ConfigError
 from dukw_common.node_tools import (SENSOR_QOS, ParamSpec, declare_parameters, diagnostic_array,
                                     run_node)
-from dukw_driver.depth_sounder import DepthReading, DepthSounderDecoder
+from dukw_driver.depth_sounder import SounderDepth, DepthSounderDecoder
 from dukw_driver.device_channel import DeviceChannel, link_from_params, require_name
 from dukw_driver.numato_adc import MAX_CHANNEL, NumatoAdc
 from dukw_driver.serial_link import DeviceHealth
@@ -109,7 +109,7 @@ class WaterSensorNode(Node):
             self.contact_frame
         return msg
 
-    def _depth(self, r: DepthReading) -> Depth:
+    def _depth(self, r: SounderDepth) -> Depth:
         msg = Depth(valid=r.valid, depth_m=r.depth_m, offset_m=r.offset_m,
                     water_temp_c=r.water_temp_c)
         msg.header.stamp, msg.header.frame_id = self.get_clock().now().to_msg(), self.depth_frame

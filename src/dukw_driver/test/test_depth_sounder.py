@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from dukw_driver.depth_sounder import DepthReading, DepthSounderDecoder
+from dukw_driver.depth_sounder import SounderDepth, DepthSounderDecoder
 from damage import damaged_stream
 from dukw_driver.nmea_stream import nmea_sentence
 
@@ -14,7 +14,7 @@ def test_dpt_depth_offset_and_temperature():
     dec = DepthSounderDecoder(min_depth_m=0.5)
     assert dec.feed(nmea_sentence('YXMTW,17.5,C'), 0.0) == []
     (reading,) = dec.feed(nmea_sentence('SDDPT,2.40,-0.25,100'), 0.5)
-    assert reading == DepthReading(True, 2.40, -0.25, 17.5)
+    assert reading == SounderDepth(True, 2.40, -0.25, 17.5)
 
 
 def test_shallower_than_half_a_metre_or_no_bottom_is_invalid_nan():

@@ -7,8 +7,8 @@ from hypothesis import strategies as st
 from pymavlink.dialects.v20 import common as mavlink
 
 from dukw_common.geometry import euler_from_quaternion
-from dukw_driver.gnss import CovarianceKind, FixStatus, GpsFix, GpsVelocity, UereSettings
-from dukw_driver.mavlink_imu import (ImuSample, ImuSettings, MavlinkImuDecoder,
+from dukw_driver.gnss import CovarianceKind, FixStatus, GnssFix, GnssVelocity, UereSettings
+from dukw_driver.mavlink_imu import (DecodedImu, ImuSettings, MavlinkImuDecoder,
                                      orientation_enu_flu_from_euler_ned,
                                      orientation_enu_flu_from_ned_frd)
 
@@ -32,7 +32,7 @@ def quaternion_message(q_wxyz, p=0.0, q=0.0, r=0.0):
 
 def test_heading_north_level_is_yaw_plus_90_deg_in_enu():
     (sample,) = MavlinkImuDecoder(SETTINGS).feed(attitude(yaw=0.0), 0.0)
-    assert isinstance(sample, ImuSample)
+    assert isinstance(sample, DecodedImu)
     roll, pitch, yaw = euler_from_quaternion(*sample.orientation_xyzw)
     assert (roll, pitch) == pytest.approx((0.0, 0.0), abs=1e-7)
     assert yaw == pytest.approx(math.pi / 2)
@@ -116,7 +116,7 @@ def test_gps_raw_int_fix_with_reported_accuracy():
         1, 3, 367000000, -1218000000, 10000, 90, 150, 0, 0, 12,
         alt_ellipsoid=-20000, h_acc=1500, v_acc=3000, vel_acc=200)
     (fix,) = MavlinkImuDecoder(SETTINGS).feed(pack(msg), 0.0)
-    assert isinstance(fix, GpsFix)
+    assert isinstance(fix, GnssFix)
     assert fix.status == FixStatus.FIX
     assert (fix.latitude_deg, fix.longitude_deg) == pytest.approx((36.7, -121.8))
     assert fix.altitude_m == pytest.approx(-20.0)
@@ -138,7 +138,7 @@ def test_gps_raw_int_without_accuracy_uses_hdop_and_no_fix_is_nan():
 def test_global_position_velocity_ned_to_enu():
     msg = mavlink.MAVLink_global_position_int_message(1, 0, 0, 0, 0, 100, -50, 20, 0)
     (vel,) = MavlinkImuDecoder(SETTINGS).feed(pack(msg), 0.0)
-    assert isinstance(vel, GpsVelocity)
+    assert isinstance(vel, GnssVelocity)
     assert (vel.east_mps, vel.north_mps, vel.up_mps) == pytest.approx((-0.5, 1.0, -0.2))
     assert vel.variance_enu == pytest.approx((0.01, 0.01, 0.01))
 
@@ -204,7 +204,7 @@ def test_truncated_corrupted_and_random_bytes_never_raise(parts, noise, chunk):
     for i in range(0, len(stream), chunk):
         out += dec.feed(bytes(stream[i:i + chunk]), 0.0)
     for item in out:
-        assert isinstance(item, (ImuSample, GpsFix, GpsVelocity))
+        assert isinstance(item, (DecodedImu, GnssFix, GnssVelocity))
     # resynchronised: the good packets after the damage decode. A damaged frame that reads
     # as an unknown id cannot be CRC-checked; when a start marker follows it by chance, the
     # good bytes it swallowed (at most 280, about one copy of PACKETS) are lost

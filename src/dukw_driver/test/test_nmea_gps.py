@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from dukw_driver.gnss import CovarianceKind, FixStatus, GpsFix, GpsVelocity, UereSettings
+from dukw_driver.gnss import CovarianceKind, FixStatus, GnssFix, GnssVelocity, UereSettings
 from dukw_driver.nmea_gps import GpsNmeaDecoder, NmeaGpsSettings
 from damage import damaged_stream
 from dukw_driver.nmea_stream import nmea_sentence
@@ -26,7 +26,7 @@ def test_dgps_fix_with_gst_covariance_in_enu_order():
     dec = GpsNmeaDecoder(SETTINGS)
     assert dec.feed(GST, 0.0) == []
     (fix,) = dec.feed(gga(quality=2), 0.5)
-    assert isinstance(fix, GpsFix)
+    assert isinstance(fix, GnssFix)
     assert fix.status == FixStatus.GBAS_FIX
     assert fix.latitude_deg == pytest.approx(36.7)
     assert fix.longitude_deg == pytest.approx(-121.8)          # W is negative
@@ -67,7 +67,7 @@ def test_fix_without_position_is_a_parse_error():
 def test_vtg_heading_east_at_10_knots_gives_east_velocity():
     dec = GpsNmeaDecoder(SETTINGS)
     (vel,) = dec.feed(nmea_sentence('GPVTG,090.0,T,,M,10.0,N,18.52,K,D'), 0.0)
-    assert isinstance(vel, GpsVelocity)
+    assert isinstance(vel, GnssVelocity)
     assert vel.east_mps == pytest.approx(18.52 / 3.6)
     assert vel.north_mps == pytest.approx(0.0, abs=1e-9)
     assert vel.variance_enu[0] == pytest.approx(0.01) and vel.variance_enu[2] > 1e3
@@ -114,7 +114,7 @@ def test_truncated_corrupted_and_random_input_never_raises(parts, noise):
     stream, damaged = damaged_stream(parts)
     out = dec.feed(stream + noise + b'\r\n', 0.0)
     for item in out:
-        assert isinstance(item, (GpsFix, GpsVelocity))
+        assert isinstance(item, (GnssFix, GnssVelocity))
     if damaged:
         assert dec.counters.errors >= 1
 

@@ -19,9 +19,9 @@ from dukw_estimation import buoyancy, traction
 from dukw_estimation.ekf import (N_STATES, SURFACE_STATES, WATERLINE_STATE, Idx, MotionEkf,
                                  Outcome, ProcessNoise)
 from dukw_estimation.force_filter import ForceSmoother
-from dukw_estimation.samples import (DepthReading, DriveStatus, GpsFix, GpsVelocity,
-                                     ImuSample, OdometryEstimate, TractionEstimate,
-                                     WaterContact)
+from dukw_common.readings import (DepthReading, DriveStatus, GpsFix, GpsVelocity, ImuSample,
+                                  WaterContact)
+from dukw_estimation.samples import OdometryEstimate, TractionEstimate
 from dukw_estimation.settings import SENSORS, EkfSettings
 
 MAX_PREDICT_STEP_S = 0.02

@@ -22,15 +22,14 @@ import json
 import math
 import sys
 from dataclasses import dataclass
-from typing import Callable, Sequence
+from typing import Sequence
 
 import numpy as np
 
 from dukw_common.config import ConfigError, node_params
-from dukw_common.geometry import euler_from_quaternion
 from dukw_common.vehicle import Vehicle, soil_params
-from dukw_estimation import samples as est_samples
 from dukw_estimation.estimator import Estimator
+from dukw_estimation.feed import feed
 from dukw_estimation.settings import EkfSettings
 
 TARGETS = {'position_rmse_m': 0.5, 'heading_rmse_deg': 3.0, 'slip_rmse': 0.05,
@@ -73,48 +72,6 @@ def _wave_overrides(height_m: float) -> dict:
     return {'waves.model': 'irregular', 'waves.significant_height_m': height_m}
 
 
-class SensorAdapter:
-    """The simulator's sensor readings -> the estimator's sample dataclasses."""
-
-    def __init__(self, estimator: Estimator) -> None:
-        self.est = estimator
-
-    def feed(self, reading) -> None:
-        """Hand one reading to the estimator (by its simulator type name)."""
-        kind = type(reading).__name__
-        handler: Callable | None = getattr(self, f'_{kind}', None)
-        if handler is None:
-            raise TypeError(f'no adapter for simulator reading {kind}')
-        handler(reading)
-
-    def _ImuReading(self, r) -> None:  # noqa: N802 (named after the reading type)
-        roll, pitch, yaw = euler_from_quaternion(*r.orientation_xyzw)
-        w, a = r.angular_velocity_rps, r.linear_acceleration_mps2
-        self.est.add_imu(est_samples.ImuSample(r.t_s, roll, pitch, yaw, w[0], w[1], w[2],
-                                               a[0], a[1], a[2], r.orientation_var[2],
-                                               r.angular_velocity_var[2]))
-
-    def _GpsFix(self, r) -> None:  # noqa: N802
-        self.est.add_gps_fix(est_samples.GpsFix(r.t_s, r.latitude_deg, r.longitude_deg,
-                                                r.altitude_m, r.position_var[0]))
-
-    def _GpsVelocity(self, r) -> None:  # noqa: N802
-        v = r.velocity_enu_mps
-        self.est.add_gps_velocity(est_samples.GpsVelocity(r.t_s, v[0], v[1], r.velocity_var[0]))
-
-    def _WaterContactReading(self, r) -> None:  # noqa: N802
-        self.est.add_water_contact(est_samples.WaterContact(r.t_s, r.fore_wet, r.aft_wet))
-
-    def _DepthReading(self, r) -> None:  # noqa: N802
-        self.est.add_depth(est_samples.DepthReading(r.t_s, r.valid, r.depth_m))
-
-    def _DrivetrainReading(self, r) -> None:  # noqa: N802
-        def side(m) -> est_samples.MotorSide:
-            return est_samples.MotorSide(m.command_pct, m.current_a, m.speed_mps, m.force_n)
-        status = est_samples.DriveStatus(r.t_s, side(r.port), side(r.stbd), r.connected)
-        (self.est.add_tracks if r.drive == 'tracks' else self.est.add_props)(status)
-
-
 def build_estimator(vehicle: Vehicle, datum: tuple[float, float, float],
                     config: str | None = None) -> Estimator:
     """The estimator as ekf_node configures it, its datum the simulator's survey origin."""
@@ -149,14 +106,13 @@ def run_scenario(scenario: Scenario, duration_s: float = 30.0, seed: int = 0,
     gps = sensors.config.gps
     est = build_estimator(vehicle, (gps.datum_lat_deg, gps.datum_lon_deg, gps.datum_alt_m),
                           config)
-    adapter = SensorAdapter(est)
     act = Actuation(*scenario.tracks_pct, *scenario.props_pct)
     rows = []
     truth = sim.truth
     for _ in range(int(round(duration_s / sim.dt_s))):
         truth = sim.step(act)
         for reading in sensors.sample(truth):
-            adapter.feed(reading)
+            feed(est, reading)
             if oracle_surface:
                 est.pin_surface(truth.waterline_distance_m, truth.wave_elevation_m)
         if truth.t_s < WARM_UP_S or est.t_s is None:

@@ -1,94 +1,12 @@
-"""What the estimator consumes and produces: plain dataclasses, SI units, REP 103/105 axes.
+"""What the estimator produces: plain dataclasses, SI units, REP 103/105 axes.
 
-The node converts messages to these; offline tools (evaluate, replay) build them directly.
-NaN marks a value the sensor did not give.
+What it consumes are the stack's sensor readings (dukw_common.readings).
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
-
-NAN = math.nan
-
-
-@dataclass(frozen=True)
-class ImuSample:
-    """IMU at base_link: attitude from its own EKF/compass, body FLU rates and specific force."""
-
-    t_s: float
-    roll_rad: float
-    pitch_rad: float
-    yaw_rad: float                  # NaN: no orientation
-    roll_rate_rps: float
-    pitch_rate_rps: float
-    yaw_rate_rps: float
-    accel_x_mps2: float             # NaN: no accelerations
-    accel_y_mps2: float
-    accel_z_mps2: float
-    yaw_var_rad2: float = NAN       # NaN or <= 0: use the configured sigma
-    yaw_rate_var_rps2: float = NAN
-
-
-@dataclass(frozen=True)
-class GpsFix:
-    """A DGPS fix, geodetic (WGS84), with horizontal variance (NaN: configured sigma)."""
-
-    t_s: float
-    latitude_deg: float
-    longitude_deg: float
-    altitude_m: float
-    horizontal_var_m2: float = NAN
-    valid: bool = True              # False: no fix (NavSatStatus.STATUS_NO_FIX)
-
-
-@dataclass(frozen=True)
-class GpsVelocity:
-    """DGPS ground velocity of the antenna, ENU, with variance per axis (NaN: configured)."""
-
-    t_s: float
-    east_mps: float
-    north_mps: float
-    var_mps2: float = NAN
-
-
-@dataclass(frozen=True)
-class WaterContact:
-    """The fore and aft water-contact sensors (debounced)."""
-
-    t_s: float
-    fore_wet: bool
-    aft_wet: bool
-
-
-@dataclass(frozen=True)
-class DepthReading:
-    """Depth sounder: water below the transducer; valid only deeper than about 0.5 m."""
-
-    t_s: float
-    valid: bool
-    depth_m: float
-
-
-@dataclass(frozen=True)
-class MotorSide:
-    """One channel of a motor controller."""
-
-    command_pct: float
-    current_a: float
-    speed_mps: float                # tracks: belt speed; propellers: 0 (no encoder)
-    force_n: float                  # tracks: current x gain; propellers: estimated thrust
-
-
-@dataclass(frozen=True)
-class DriveStatus:
-    """A dual-channel controller (tracks or propellers)."""
-
-    t_s: float
-    port: MotorSide
-    stbd: MotorSide
-    connected: bool = True
 
 
 @dataclass

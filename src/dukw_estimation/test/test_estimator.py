@@ -13,8 +13,8 @@ from dukw_estimation import traction
 from dukw_estimation.ekf import Idx, Outcome
 from dukw_estimation.estimator import Estimator
 from dukw_estimation.force_filter import ForceSmoother
-from dukw_estimation.samples import (DepthReading, DriveStatus, GpsFix, GpsVelocity,
-                                     ImuSample, MotorSide, WaterContact)
+from dukw_common.readings import (DepthReading, DriveStatus, GpsFix, GpsVelocity, ImuSample,
+                                  MotorSide, WaterContact)
 from dukw_estimation.settings import EkfSettings
 
 PARAMS = node_params('ekf_node')

@@ -1,6 +1,7 @@
 """What the vehicle's devices report, given the simulator's ground truth (ROS-free).
 
-`SensorModel` turns a `Truth` into the readings the real devices give, each at
+`SensorModel` turns a `Truth` into the readings the real devices give
+(dukw_common.readings, the types the estimator consumes), each at
 its own rate and with its own noise (config ``sim_node`` block: ``rates.*``,
 ``noise.*``, ``gps.*``, ``water_contact.*``, ``depth.*``, ``battery.*``, ``motors.*``;
 mounting points from the shared ``sensors.*``). Every device has its own
@@ -23,10 +24,12 @@ from typing import Mapping
 import numpy as np
 
 from dukw_common.config import ConfigError, ParamValue, build_settings, node_params, require
-from dukw_common.geometry import geodetic_from_local_enu, quaternion_from_euler
+from dukw_common.geometry import geodetic_from_local_enu
+from dukw_common.readings import (DepthReading, DriveStatus, GpsFix, GpsVelocity, ImuSample,
+                                  MotorSide, WaterContact)
 from dukw_common.vehicle import (DrivetrainParams, SensorMounts, drivetrain_params,
                                   sensor_mounts)
-from dukw_driver.motors import SideStatus, prop_thrust_n
+from dukw_driver.motors import prop_thrust_n
 from dukw_sim.truth import Truth
 
 NODE_NAME = 'sim_node'
@@ -34,73 +37,7 @@ NODE_NAME = 'sim_node'
 SENSOR_STREAMS = ('imu', 'gps', 'water', 'depth', 'motors')
 
 
-# ----------------------------------------------------------------------------- readings
-
-@dataclass(frozen=True)
-class ImuReading:
-    """GPS-aided IMU: orientation (ENU, x y z w), body rates and specific force (FLU)."""
-
-    t_s: float
-    orientation_xyzw: tuple[float, float, float, float]
-    orientation_var: tuple[float, float, float]        # roll, pitch, yaw, rad^2
-    angular_velocity_rps: tuple[float, float, float]
-    angular_velocity_var: tuple[float, float, float]
-    linear_acceleration_mps2: tuple[float, float, float]
-    linear_acceleration_var: tuple[float, float, float]
-
-
-@dataclass(frozen=True)
-class GpsFix:
-    """DGPS position of the antenna and its covariance (east, north, up), m^2."""
-
-    t_s: float
-    latitude_deg: float
-    longitude_deg: float
-    altitude_m: float
-    position_var: tuple[float, float, float]
-
-
-@dataclass(frozen=True)
-class GpsVelocity:
-    """DGPS velocity of the antenna, ENU, with its variance, (m/s)^2."""
-
-    t_s: float
-    velocity_enu_mps: tuple[float, float, float]
-    velocity_var: tuple[float, float, float]
-
-
-@dataclass(frozen=True)
-class WaterContactReading:
-    """Fore/aft water-contact sensors: debounced wet flags and raw levels 0..1."""
-
-    t_s: float
-    fore_wet: bool
-    aft_wet: bool
-    fore_level: float
-    aft_level: float
-
-
-@dataclass(frozen=True)
-class DepthReading:
-    """Depth sounder: water below the transducer; NaN and invalid when too shallow."""
-
-    t_s: float
-    valid: bool
-    depth_m: float
-    offset_m: float
-    water_temp_c: float
-
-
-@dataclass(frozen=True)
-class DrivetrainReading:
-    """A dual-channel motor controller: tracks or propellers."""
-
-    t_s: float
-    drive: str                     # 'tracks' | 'props'
-    connected: bool
-    port: SideStatus               # one motor channel, as the real driver reports it
-    stbd: SideStatus
-
+# ----------------------------------------------------------------------------- faults
 
 class Fault(IntFlag):
     """The fault bits of dukw_msgs/MotorSide (FAULT_*) the simulator raises."""
@@ -443,7 +380,7 @@ class SensorModel:
         self._last_t[stream] = t_s
         return 0.0 if last is None else max(0.0, t_s - last)
 
-    def imu(self, truth: Truth) -> ImuReading:
+    def imu(self, truth: Truth) -> ImuSample:
         """The IMU at imu_link: its EKF's attitude, gyro rates with bias, specific force."""
         noise, h = self.config.noise, self.config.mounts.imu_z_m
         dt = self._dt('imu', truth.t_s)
@@ -462,15 +399,14 @@ class SensorModel:
         fz = truth.accel_z_mps2 - (wx * wx + wy * wy) * h
         bias, g = self._gyro_bias, noise.gyro_std_rps
         sx, sy, sz = noise.accel_x_std_mps2, noise.accel_y_std_mps2, noise.accel_z_std_mps2
-        quat = quaternion_from_euler(truth.roll_rad + err[0], truth.pitch_rad + err[1],
-                                     truth.yaw_rad + err[2])
-        return ImuReading(
-            truth.t_s, quat,
-            (noise.attitude_std_rad ** 2, noise.attitude_std_rad ** 2, noise.heading_std_rad ** 2),
-            (wx + bias[0] + g * d[0], wy + bias[1] + g * d[1], wz + bias[2] + g * d[2]),
-            (g * g, g * g, g * g),
-            (fx + sx * d[3], fy + sy * d[4], fz + sz * d[5]),
-            (sx * sx, sy * sy, sz * sz))
+        att2, head2 = noise.attitude_std_rad ** 2, noise.heading_std_rad ** 2
+        return ImuSample(
+            truth.t_s, truth.roll_rad + err[0], truth.pitch_rad + err[1], truth.yaw_rad + err[2],
+            wx + bias[0] + g * d[0], wy + bias[1] + g * d[1], wz + bias[2] + g * d[2],
+            fx + sx * d[3], fy + sy * d[4], fz + sz * d[5],
+            yaw_var_rad2=head2, yaw_rate_var_rps2=g * g, roll_var_rad2=att2,
+            pitch_var_rad2=att2, roll_rate_var_rps2=g * g, pitch_rate_var_rps2=g * g,
+            accel_var_m2ps4=(sx * sx, sy * sy, sz * sz))
 
     def antenna_enu(self, truth: Truth) -> tuple[float, float, float]:
         """True position of the GPS antenna in odom (ENU), m: base_link + R (0, 0, h)."""
@@ -494,7 +430,8 @@ class SensorModel:
                                                 gps.datum_lat_deg, gps.datum_lon_deg,
                                                 gps.datum_alt_m)
         h2, v2 = noise.gps_horizontal_std_m ** 2, noise.gps_vertical_std_m ** 2
-        return GpsFix(truth.t_s, lat, lon, alt, (h2, h2, v2))
+        return GpsFix(truth.t_s, lat, lon, alt, horizontal_var_m2=h2, valid=True,
+                      vertical_var_m2=v2)
 
     def gps_velocity(self, truth: Truth) -> GpsVelocity:
         """DGPS velocity of the antenna, ENU: body velocity plus w x r, rotated; white noise."""
@@ -503,18 +440,18 @@ class SensorModel:
         u = truth.surge_mps + truth.pitch_rate_rps * h
         v = truth.sway_mps - truth.roll_rate_rps * h
         cy, sy = math.cos(truth.yaw_rad), math.sin(truth.yaw_rad)
-        return GpsVelocity(truth.t_s, (cy * u - sy * v + s * d[0], sy * u + cy * v + s * d[1],
-                                       truth.heave_mps + s * d[2]), (s * s, s * s, s * s))
+        return GpsVelocity(truth.t_s, cy * u - sy * v + s * d[0], sy * u + cy * v + s * d[1],
+                           var_mps2=s * s, up_mps=truth.heave_mps + s * d[2], up_var_mps2=s * s)
 
-    def water(self, truth: Truth) -> WaterContactReading:
+    def water(self, truth: Truth) -> WaterContact:
         """Water contact: the level ramps 0 -> 1 across the lead gap around the sensor point."""
         water, s = self.config.water, self.config.noise.water_level_std
         d = self._noise['water'].draw()
         gap = max(water.lead_gap_m, 1e-6)
         fore = _clip01(0.5 + truth.fore_sensor_depth_m / gap + s * d[0])
         aft = _clip01(0.5 + truth.aft_sensor_depth_m / gap + s * d[1])
-        return WaterContactReading(truth.t_s, self._fore.update(fore >= water.wet_level),
-                                   self._aft.update(aft >= water.wet_level), fore, aft)
+        return WaterContact(truth.t_s, self._fore.update(fore >= water.wet_level),
+                            self._aft.update(aft >= water.wet_level), fore, aft)
 
     def depth(self, truth: Truth) -> DepthReading:
         """Depth below the transducer; invalid (NaN) out of water or shallower than the minimum."""
@@ -523,9 +460,10 @@ class SensorModel:
         valid = (truth.sounder_depth_m > 0.0
                  and truth.water_depth_m > cfg.mounts.depth_sounder_min_m)
         depth_m = truth.sounder_depth_m + cfg.noise.depth_std_m * d[0] if valid else math.nan
-        return DepthReading(truth.t_s, valid, depth_m, cfg.depth.offset_m, cfg.depth.water_temp_c)
+        return DepthReading(truth.t_s, valid, depth_m, cfg.depth.offset_m,
+                            cfg.depth.water_temp_c)
 
-    def tracks(self, truth: Truth) -> DrivetrainReading:
+    def tracks(self, truth: Truth) -> DriveStatus:
         """The tracks' controller: command, current, pack voltage, belt speed, force = I x gain."""
         gain = self.config.drivetrain.track_force_gain_n_per_a
         return self._drivetrain(
@@ -534,7 +472,7 @@ class SensorModel:
             (truth.port_track_speed_mps, truth.stbd_track_speed_mps),
             lambda current_a, pct: current_a * gain)
 
-    def props(self, truth: Truth) -> DrivetrainReading:
+    def props(self, truth: Truth) -> DriveStatus:
         """The propellers' controller: no encoder (speed 0); thrust estimated from the command
         as motor_controller_node does (dukw_driver.motors.prop_thrust_n)."""
         drivetrain = self.config.drivetrain
@@ -544,7 +482,7 @@ class SensorModel:
             lambda current_a, pct: prop_thrust_n(pct, drivetrain))
 
     def _drivetrain(self, truth: Truth, drive: str, commands: tuple, currents: tuple,
-                    speeds: tuple | None, force_n) -> DrivetrainReading:
+                    speeds: tuple | None, force_n) -> DriveStatus:
         noise, battery = self.config.noise, self.config.battery
         dt = self._dt(drive, truth.t_s)
         d = self._noise[drive].draw()
@@ -564,8 +502,9 @@ class SensorModel:
             flags = self._motors[drive, side].update(dt, currents[i], stalling, voltage, under_v)
             current = currents[i] + noise.current_std_a * d[3 * i]
             speed = 0.0 if speeds is None else true_speed + noise.speed_std_mps * d[3 * i + 1]
-            sides.append(SideStatus(
-                commands[i], current, voltage + noise.voltage_std_v * d[3 * i + 2], speed,
-                force_n(current, commands[i]), self._motors[drive, side].temperature_c,
-                int(flags), flags.names()))
-        return DrivetrainReading(truth.t_s, drive, True, sides[0], sides[1])
+            sides.append(MotorSide(
+                commands[i], current, speed, force_n(current, commands[i]),
+                voltage_v=voltage + noise.voltage_std_v * d[3 * i + 2],
+                temperature_c=self._motors[drive, side].temperature_c,
+                fault_flags=int(flags), faults=flags.names()))
+        return DriveStatus(truth.t_s, sides[0], sides[1], connected=True, drive=drive)

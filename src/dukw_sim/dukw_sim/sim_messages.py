@@ -1,5 +1,11 @@
 """ROS messages from the simulator's readings (sensors.py, switch.py, truth.py).
 
+Sensor readings (dukw_common.readings) are written so that the estimator's reader,
+dukw_estimation.ros_convert, gives the same reading back: a NaN variance becomes 0
+("unknown"), a reading without orientation or accelerations gets covariance[0] = -1,
+a fix without horizontal variance COVARIANCE_TYPE_UNKNOWN, a valid fix the DGPS's
+STATUS_GBAS_FIX and an invalid one STATUS_NO_FIX.
+
 The only dukw_sim module besides sim_node that knows message types. Each topic
 has one message object that is updated in place and returned: publishing
 serialises at once, and setting fields costs a tenth of building a message
@@ -12,24 +18,25 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from diagnostic_msgs.msg import DiagnosticArray
-from dukw_msgs.msg import Authority, Depth, DrivetrainStatus, MotorSide, RcInput, SimTruth
-from dukw_msgs.msg import WaterContact
+from dukw_msgs.msg import Authority, Depth, DrivetrainStatus, RcInput, SimTruth
+from dukw_msgs.msg import MotorSide as MotorSideMsg
+from dukw_msgs.msg import WaterContact as WaterContactMsg
 from geometry_msgs.msg import TwistWithCovarianceStamped
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, NavSatFix, NavSatStatus
 
+from dukw_common.geometry import quaternion_from_euler
 from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS
+from dukw_common.readings import (DepthReading, DriveStatus, GpsFix, GpsVelocity, ImuSample,
+                                  MotorSide, WaterContact, reading_topic)
 from dukw_driver.authority import AuthorityState
-from dukw_driver.motors import SideStatus
-from dukw_sim.sensors import (DepthReading, DrivetrainReading, GpsFix, GpsVelocity,
-                              ImuReading, WaterContactReading)
 from dukw_sim.switch import RcReading
 from dukw_sim.truth import Truth
 
 #: What sim_node publishes: the drivers' topic contract (architecture.md) plus sim/truth, /clock.
 TOPICS = [('imu/data', Imu, SENSOR_QOS), ('gps/fix', NavSatFix, SENSOR_QOS),
           ('gps/vel', TwistWithCovarianceStamped, SENSOR_QOS),
-          ('water/contact', WaterContact, SENSOR_QOS), ('depth', Depth, SENSOR_QOS),
+          ('water/contact', WaterContactMsg, SENSOR_QOS), ('depth', Depth, SENSOR_QOS),
           ('tracks/status', DrivetrainStatus, SENSOR_QOS),
           ('props/status', DrivetrainStatus, SENSOR_QOS), ('rc/input', RcInput, SENSOR_QOS),
           ('authority', Authority, STATE_QOS), ('sim/truth', SimTruth, SENSOR_QOS),
@@ -61,11 +68,23 @@ def set_stamp(header, t_s: float) -> None:
     set_time(header.stamp, t_s)
 
 
+def _given(var: float) -> float:
+    """A variance as a covariance entry: 0 ("unknown") where the reading has NaN."""
+    return var if var == var else 0.0
+
+
 def _diag3(var: tuple) -> list[float]:
-    return [var[0], 0.0, 0.0, 0.0, var[1], 0.0, 0.0, 0.0, var[2]]
+    return [_given(var[0]), 0.0, 0.0, 0.0, _given(var[1]), 0.0, 0.0, 0.0, _given(var[2])]
 
 
-def _fill_side(side: MotorSide, m: SideStatus) -> None:
+#: covariance[0] = -1: the field is not given (REP 145, sensor_msgs/Imu)
+_NOT_GIVEN = [-1.0] + [0.0] * 8
+#: DriveStatus.drive -> dukw_msgs/DrivetrainStatus.drive
+DRIVE_VALUES = {'tracks': DrivetrainStatus.DRIVE_TRACKS,
+                'props': DrivetrainStatus.DRIVE_PROPELLERS}
+
+
+def _fill_side(side: MotorSideMsg, m: MotorSide) -> None:
     side.command_pct, side.current_a, side.voltage_v = m.command_pct, m.current_a, m.voltage_v
     side.speed_mps, side.force_n, side.temperature_c = m.speed_mps, m.force_n, m.temperature_c
     side.fault_flags, side.faults = m.fault_flags, list(m.faults)
@@ -87,12 +106,12 @@ class SimMessages:
         self._vel = TwistWithCovarianceStamped()
         self._vel.header.frame_id = frames.gps
         self._vel_var: tuple | None = None
-        self._water = WaterContact()
+        self._water = WaterContactMsg()
         self._water.header.frame_id = frames.base
         self._depth = Depth()
         self._depth.header.frame_id = frames.base
-        self._drives = {'tracks': DrivetrainStatus(drive=DrivetrainStatus.DRIVE_TRACKS),
-                        'props': DrivetrainStatus(drive=DrivetrainStatus.DRIVE_PROPELLERS)}
+        self._drives = {name: DrivetrainStatus(drive=value)
+                        for name, value in DRIVE_VALUES.items()}
         for msg in self._drives.values():
             msg.header.frame_id = frames.base
         self._rc = RcInput()
@@ -100,42 +119,54 @@ class SimMessages:
         self._truth = SimTruth()
         self._truth.header.frame_id = frames.odom
         self._clock = Clock()
-        self._by_type = {ImuReading: ('imu/data', self.imu), GpsFix: ('gps/fix', self.gps_fix),
-                         GpsVelocity: ('gps/vel', self.gps_velocity),
-                         WaterContactReading: ('water/contact', self.water_contact),
-                         DepthReading: ('depth', self.depth)}
+        self._by_type = {ImuSample: self.imu, GpsFix: self.gps_fix,
+                         GpsVelocity: self.gps_velocity, WaterContact: self.water_contact,
+                         DepthReading: self.depth}
 
     def reading(self, r) -> tuple[str, object]:
         """(topic, message) for any reading SensorModel.sample gives."""
-        if isinstance(r, DrivetrainReading):
-            return f'{r.drive}/status', self.drivetrain(r)
-        topic, build = self._by_type[type(r)]
-        return topic, build(r)
+        if isinstance(r, DriveStatus):
+            return reading_topic(r), self.drivetrain(r)
+        return reading_topic(r), self._by_type[type(r)](r)
 
-    def imu(self, r: ImuReading) -> Imu:
+    def imu(self, r: ImuSample) -> Imu:
         """sensor_msgs/Imu: orientation ENU (REP 145), rates and specific force in imu_link."""
         msg = self._imu
         set_stamp(msg.header, r.t_s)
         q, w, a = msg.orientation, msg.angular_velocity, msg.linear_acceleration
-        q.x, q.y, q.z, q.w = r.orientation_xyzw
-        w.x, w.y, w.z = r.angular_velocity_rps
-        a.x, a.y, a.z = r.linear_acceleration_mps2
-        var = (r.orientation_var, r.angular_velocity_var, r.linear_acceleration_var)
-        if var != self._imu_var:
+        has_attitude = r.yaw_rad == r.yaw_rad
+        has_accel = r.accel_x_mps2 == r.accel_x_mps2
+        q.x, q.y, q.z, q.w = (quaternion_from_euler(r.roll_rad, r.pitch_rad, r.yaw_rad)
+                              if has_attitude else (0.0, 0.0, 0.0, 1.0))
+        w.x, w.y, w.z = r.roll_rate_rps, r.pitch_rate_rps, r.yaw_rate_rps
+        a.x, a.y, a.z = ((r.accel_x_mps2, r.accel_y_mps2, r.accel_z_mps2) if has_accel
+                         else (0.0, 0.0, 0.0))
+        var = (has_attitude, r.roll_var_rad2, r.pitch_var_rad2, r.yaw_var_rad2,
+               r.roll_rate_var_rps2, r.pitch_rate_var_rps2, r.yaw_rate_var_rps2,
+               has_accel, r.accel_var_m2ps4)
+        if var != self._imu_var:        # NaN != NaN: rebuilt each time then, still right
             self._imu_var = var
-            msg.orientation_covariance = _diag3(r.orientation_var)
-            msg.angular_velocity_covariance = _diag3(r.angular_velocity_var)
-            msg.linear_acceleration_covariance = _diag3(r.linear_acceleration_var)
+            msg.orientation_covariance = (_diag3(var[1:4]) if has_attitude else _NOT_GIVEN)
+            msg.angular_velocity_covariance = _diag3(var[4:7])
+            msg.linear_acceleration_covariance = (_diag3(r.accel_var_m2ps4) if has_accel
+                                                  else _NOT_GIVEN)
         return msg
 
     def gps_fix(self, r: GpsFix) -> NavSatFix:
-        """sensor_msgs/NavSatFix: a differential (GBAS) fix, known diagonal covariance (ENU)."""
+        """sensor_msgs/NavSatFix: a differential (GBAS) fix, diagonal covariance (ENU)."""
         msg = self._fix
         set_stamp(msg.header, r.t_s)
         msg.latitude, msg.longitude, msg.altitude = r.latitude_deg, r.longitude_deg, r.altitude_m
-        if r.position_var != self._fix_var:
-            self._fix_var = r.position_var
-            msg.position_covariance = _diag3(r.position_var)
+        msg.status.status = (NavSatStatus.STATUS_GBAS_FIX if r.valid
+                             else NavSatStatus.STATUS_NO_FIX)
+        var = (r.horizontal_var_m2, r.vertical_var_m2)
+        if var != self._fix_var:
+            self._fix_var = var
+            known = r.horizontal_var_m2 == r.horizontal_var_m2
+            msg.position_covariance_type = (NavSatFix.COVARIANCE_TYPE_DIAGONAL_KNOWN if known
+                                            else NavSatFix.COVARIANCE_TYPE_UNKNOWN)
+            msg.position_covariance = _diag3((r.horizontal_var_m2, r.horizontal_var_m2,
+                                              r.vertical_var_m2))
         return msg
 
     def gps_velocity(self, r: GpsVelocity) -> TwistWithCovarianceStamped:
@@ -143,16 +174,18 @@ class SimMessages:
         msg = self._vel
         set_stamp(msg.header, r.t_s)
         v = msg.twist.twist.linear
-        v.x, v.y, v.z = r.velocity_enu_mps
-        if r.velocity_var != self._vel_var:
-            self._vel_var = r.velocity_var
+        v.x, v.y, v.z = r.east_mps, r.north_mps, r.up_mps
+        var = (r.var_mps2, r.up_var_mps2)
+        if var != self._vel_var:
+            self._vel_var = var
             cov = [0.0] * 36
-            cov[0], cov[7], cov[14] = r.velocity_var
+            cov[0] = cov[7] = _given(r.var_mps2)
+            cov[14] = _given(r.up_var_mps2)
             cov[21] = cov[28] = cov[35] = UNMEASURED_VAR
             msg.twist.covariance = cov
         return msg
 
-    def water_contact(self, r: WaterContactReading) -> WaterContact:
+    def water_contact(self, r: WaterContact) -> WaterContactMsg:
         """dukw_msgs/WaterContact (the sensor points are config sensors.* in base_link)."""
         msg = self._water
         set_stamp(msg.header, r.t_s)
@@ -168,8 +201,10 @@ class SimMessages:
         msg.offset_m, msg.water_temp_c = r.offset_m, r.water_temp_c
         return msg
 
-    def drivetrain(self, r: DrivetrainReading) -> DrivetrainStatus:
+    def drivetrain(self, r: DriveStatus) -> DrivetrainStatus:
         """dukw_msgs/DrivetrainStatus for tracks/status or props/status."""
+        if r.drive not in self._drives:
+            raise ValueError(f"DriveStatus.drive must be 'tracks' or 'props', got {r.drive!r}")
         msg = self._drives[r.drive]
         set_stamp(msg.header, r.t_s)
         msg.connected = r.connected

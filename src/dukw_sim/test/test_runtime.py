@@ -5,11 +5,12 @@ import pytest
 from dukw_msgs.msg import Authority, DrivetrainStatus, MotorSide, SimTruth
 
 from dukw_common.diagnostics import Level
+from dukw_common.readings import (DepthReading, DriveStatus, GpsFix, GpsVelocity, ImuSample,
+                                  WaterContact)
+from dukw_common.readings import MotorSide as SideReading
 from dukw_driver.authority import AuthorityState, Holder, Reason
-from dukw_driver.motors import SideStatus
 from dukw_sim.runtime import Pacer, SpeedMeter, sim_healths
-from dukw_sim.sensors import (DepthReading, DrivetrainReading, Fault, GpsFix, GpsVelocity,
-                              ImuReading, WaterContactReading)
+from dukw_sim.sensors import Fault
 from dukw_sim.sim_messages import TOPICS, Frames, SimMessages
 from dukw_sim.switch import RcReading
 from dukw_sim.truth import Medium, Truth
@@ -96,21 +97,24 @@ def test_topics_are_the_contract_with_the_right_qos():
 
 def test_readings_become_messages_on_their_topics():
     msgs = SimMessages(FRAMES)
-    imu = ImuReading(1.25, (0.0, 0.0, 0.6, 0.8), (1e-5, 1e-5, 7e-5), (0.1, 0.2, 0.3),
-                     (9e-6,) * 3, (0.0, 0.1, 9.8), (1e-4, 8.1e-5, 8.1e-5))
+    imu = ImuSample(1.25, 0.0, 0.0, 2 * math.atan2(0.6, 0.8), 0.1, 0.2, 0.3, 0.0, 0.1, 9.8,
+                    yaw_var_rad2=7e-5, yaw_rate_var_rps2=9e-6, roll_var_rad2=1e-5,
+                    pitch_var_rad2=1e-5, roll_rate_var_rps2=9e-6, pitch_rate_var_rps2=9e-6,
+                    accel_var_m2ps4=(1e-4, 8.1e-5, 8.1e-5))
     topic, msg = msgs.reading(imu)
     assert topic == 'imu/data' and msg.header.frame_id == 'imu_link'
     assert (msg.header.stamp.sec, msg.header.stamp.nanosec) == (1, 250_000_000)
-    assert (msg.orientation.z, msg.orientation.w, msg.angular_velocity.z) == (0.6, 0.8, 0.3)
+    assert (msg.orientation.z, msg.orientation.w) == pytest.approx((0.6, 0.8), abs=1e-15)
+    assert msg.angular_velocity.z == 0.3
     assert list(msg.orientation_covariance) == [1e-5, 0, 0, 0, 1e-5, 0, 0, 0, 7e-5]
-    topic, fix = msgs.reading(GpsFix(2.0, 36.1, -75.7, 1.0, (0.09, 0.09, 0.36)))
+    topic, fix = msgs.reading(GpsFix(2.0, 36.1, -75.7, 1.0, 0.09, True, 0.36))
     assert topic == 'gps/fix' and fix.latitude == 36.1 and fix.position_covariance[8] == 0.36
     assert fix.position_covariance_type == fix.COVARIANCE_TYPE_DIAGONAL_KNOWN
     assert fix.status.status == fix.status.STATUS_GBAS_FIX
-    topic, vel = msgs.reading(GpsVelocity(2.0, (1.0, -0.5, 0.1), (0.0025,) * 3))
+    topic, vel = msgs.reading(GpsVelocity(2.0, 1.0, -0.5, 0.0025, 0.1, 0.0025))
     assert topic == 'gps/vel' and vel.twist.twist.linear.y == -0.5
     assert vel.twist.covariance[7] == 0.0025 and vel.twist.covariance[35] > 1e3
-    topic, water = msgs.reading(WaterContactReading(2.0, True, False, 0.9, 0.1))
+    topic, water = msgs.reading(WaterContact(2.0, True, False, 0.9, 0.1))
     assert topic == 'water/contact' and water.fore_wet and not water.aft_wet
     topic, depth = msgs.reading(DepthReading(2.0, False, math.nan, 0.0, 18.0))
     assert topic == 'depth' and not depth.valid and math.isnan(depth.depth_m)
@@ -119,16 +123,16 @@ def test_readings_become_messages_on_their_topics():
 def test_drivetrain_faults_are_decoded_to_names():
     msgs = SimMessages(FRAMES)
     flags = Fault.STALL | Fault.OVERHEAT
-    side = SideStatus(100.0, 60.0, 23.0, 0.0, 489.6, 80.0, int(flags), flags.names())
-    ok = SideStatus(50.0, 10.0, 24.0, 1.0, 81.6, 30.0, 0, Fault(0).names())
-    topic, msg = msgs.reading(DrivetrainReading(3.0, 'tracks', True, side, ok))
+    side = SideReading(100.0, 60.0, 0.0, 489.6, 23.0, 80.0, int(flags), flags.names())
+    ok = SideReading(50.0, 10.0, 1.0, 81.6, 24.0, 30.0, 0, Fault(0).names())
+    topic, msg = msgs.reading(DriveStatus(3.0, side, ok, True, 'tracks'))
     assert topic == 'tracks/status' and msg.drive == DrivetrainStatus.DRIVE_TRACKS
     assert msg.port.fault_flags == MotorSide.FAULT_STALL | MotorSide.FAULT_OVERHEAT
     assert sorted(msg.port.faults) == ['overheat', 'stall'] and list(msg.stbd.faults) == []
-    topic, msg = msgs.reading(DrivetrainReading(3.0, 'props', True, ok, ok))
+    topic, msg = msgs.reading(DriveStatus(3.0, ok, ok, True, 'props'))
     assert topic == 'props/status' and msg.drive == DrivetrainStatus.DRIVE_PROPELLERS
     # the same side clears its faults when they go
-    topic, msg = msgs.reading(DrivetrainReading(3.1, 'tracks', True, ok, ok))
+    topic, msg = msgs.reading(DriveStatus(3.1, ok, ok, True, 'tracks'))
     assert msg.port.fault_flags == 0 and list(msg.port.faults) == []
 
 

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from dukw_common.config import ConfigError, node_params
-from dukw_common.geometry import euler_from_quaternion, local_enu_from_geodetic
-from dukw_sim.sensors import (DepthReading, DrivetrainReading, Fault, GaussMarkov, GpsFix,
-                              GpsVelocity, ImuReading, Schedule, SensorConfig, SensorModel,
-                              WaterContactReading)
+from dukw_common.geometry import local_enu_from_geodetic
+from dukw_common.readings import (DepthReading, DriveStatus, GpsFix, GpsVelocity, ImuSample,
+                                  WaterContact)
+from dukw_sim.sensors import Fault, GaussMarkov, Schedule, SensorConfig, SensorModel
 from dukw_sim.truth import Truth
 
 PARAMS = node_params('sim_node')
@@ -43,16 +43,16 @@ def test_quiet_config_really_is_quiet():
 def test_each_device_at_its_configured_rate():
     readings = run(model(), Truth(), 10.0)
     counts = {kind.__name__: len(of(kind, readings)) for kind in (
-        ImuReading, GpsFix, GpsVelocity, WaterContactReading, DepthReading)}
-    assert counts == {'ImuReading': 1000, 'GpsFix': 100, 'GpsVelocity': 100,
-                      'WaterContactReading': 200, 'DepthReading': 50}
-    assert len(of(DrivetrainReading, readings, 'tracks')) == 200
-    assert len(of(DrivetrainReading, readings, 'props')) == 200
+        ImuSample, GpsFix, GpsVelocity, WaterContact, DepthReading)}
+    assert counts == {'ImuSample': 1000, 'GpsFix': 100, 'GpsVelocity': 100,
+                      'WaterContact': 200, 'DepthReading': 50}
+    assert len(of(DriveStatus, readings, 'tracks')) == 200
+    assert len(of(DriveStatus, readings, 'props')) == 200
 
 
 def test_rates_come_from_config():
     readings = run(model(**{'rates.imu_hz': 50.0, 'rates.depth_hz': 1.0}), Truth(), 4.0)
-    assert len(of(ImuReading, readings)) == 200
+    assert len(of(ImuSample, readings)) == 200
     assert len(of(DepthReading, readings)) == 4
 
 
@@ -70,36 +70,36 @@ def test_reset_replays_the_same_noise():
 
 
 def test_one_devices_rate_does_not_change_anothers_noise():
-    imu_a = of(ImuReading, run(model(1), Truth(), 1.0))
-    imu_b = of(ImuReading, run(model(1, **{'rates.gps_hz': 1.0}), Truth(), 1.0))
+    imu_a = of(ImuSample, run(model(1), Truth(), 1.0))
+    imu_b = of(ImuSample, run(model(1, **{'rates.gps_hz': 1.0}), Truth(), 1.0))
     assert imu_a == imu_b
 
 
 def test_imu_noise_matches_table_iii_and_the_gyro_bias_is_constant():
     m = model(11)
-    imu = of(ImuReading, run(m, Truth(), 60.0))
-    acc = np.array([r.linear_acceleration_mps2 for r in imu])
-    gyro = np.array([r.angular_velocity_rps for r in imu])
+    imu = of(ImuSample, run(m, Truth(), 60.0))
+    acc = np.array([(r.accel_x_mps2, r.accel_y_mps2, r.accel_z_mps2) for r in imu])
+    gyro = np.array([(r.roll_rate_rps, r.pitch_rate_rps, r.yaw_rate_rps) for r in imu])
     np.testing.assert_allclose(acc.std(axis=0), [0.010, 0.009, 0.009], rtol=0.1)
     np.testing.assert_allclose(acc.mean(axis=0), [0.0, 0.0, 9.81], atol=0.002)
     np.testing.assert_allclose(gyro.std(axis=0), math.radians(0.172), rtol=0.1)
     np.testing.assert_allclose(gyro.mean(axis=0), m.gyro_bias_rps, atol=3e-4)
     assert any(abs(b) > 1e-5 for b in m.gyro_bias_rps)
-    assert imu[0].linear_acceleration_var == pytest.approx((1e-4, 8.1e-5, 8.1e-5))
+    assert imu[0].accel_var_m2ps4 == pytest.approx((1e-4, 8.1e-5, 8.1e-5))
 
 
 def test_imu_orientation_is_enu_with_compass_heading_error_as_configured():
     truth = Truth(roll_rad=0.1, pitch_rad=-0.05, yaw_rad=2.0)
-    imu = of(ImuReading, run(model(2), truth, 120.0))
-    angles = np.array([euler_from_quaternion(*r.orientation_xyzw) for r in imu])
-    assert all(abs(np.linalg.norm(r.orientation_xyzw) - 1.0) < 1e-12 for r in imu)
+    imu = of(ImuSample, run(model(2), truth, 120.0))
+    angles = np.array([(r.roll_rad, r.pitch_rad, r.yaw_rad) for r in imu])
     np.testing.assert_allclose(angles.mean(axis=0), [0.1, -0.05, 2.0], atol=0.01)
     yaw_err = angles[:, 2] - 2.0
     assert 0.003 < yaw_err.std() < 0.02          # 0.5 deg configured, correlated over 10 s
     # correlated error: neighbouring samples are nearly equal
     assert np.abs(np.diff(yaw_err)).max() < 0.002
-    quiet = of(ImuReading, run(quiet_model(), truth, 0.05))
-    assert euler_from_quaternion(*quiet[0].orientation_xyzw) == pytest.approx((0.1, -0.05, 2.0))
+    quiet = of(ImuSample, run(quiet_model(), truth, 0.05))
+    q = quiet[0]
+    assert (q.roll_rad, q.pitch_rad, q.yaw_rad) == pytest.approx((0.1, -0.05, 2.0))
 
 
 def test_imu_above_base_link_feels_lever_arm_accelerations():
@@ -109,7 +109,8 @@ def test_imu_above_base_link_feels_lever_arm_accelerations():
     # 0.5 rad/s: centripetal w_z w_x h on x
     readings = [m.imu(Truth(t_s=k * 0.01, roll_rate_rps=0.5 + k * 0.01, yaw_rate_rps=1.0))
                 for k in range(3)]
-    fx, fy, fz = readings[2].linear_acceleration_mps2
+    r = readings[2]
+    fx, fy, fz = r.accel_x_mps2, r.accel_y_mps2, r.accel_z_mps2
     assert fy == pytest.approx(-1.0 * h, rel=1e-6)
     assert fx == pytest.approx(1.0 * 0.52 * h, rel=1e-6)
     assert fz == pytest.approx(9.81 - 0.52 ** 2 * h, rel=1e-6)
@@ -140,14 +141,14 @@ def test_gps_error_and_its_reported_covariance_agree():
     enu = np.array([gps_enu(f) for f in fixes])
     std = PARAMS['noise.gps_horizontal_std_m']
     np.testing.assert_allclose(enu[:, :2].std(axis=0), std, rtol=0.15)
-    assert fixes[0].position_var == pytest.approx((std ** 2, std ** 2,
-                                                   PARAMS['noise.gps_vertical_std_m'] ** 2))
+    assert fixes[0].horizontal_var_m2 == pytest.approx(std ** 2)
+    assert fixes[0].vertical_var_m2 == pytest.approx(PARAMS['noise.gps_vertical_std_m'] ** 2)
 
 
 def test_gps_velocity_is_enu():
     m = quiet_model()
     vel = m.gps_velocity(Truth(yaw_rad=math.pi / 2, surge_mps=1.2, sway_mps=0.1, heave_mps=0.2))
-    assert vel.velocity_enu_mps == pytest.approx((-0.1, 1.2, 0.2), abs=1e-9)
+    assert (vel.east_mps, vel.north_mps, vel.up_mps) == pytest.approx((-0.1, 1.2, 0.2), abs=1e-9)
 
 
 @pytest.mark.parametrize('depth_m,wet,level', [(0.05, True, 1.0), (-0.05, False, 0.0),
@@ -205,7 +206,7 @@ def test_stall_fault_after_the_stall_time_with_the_belt_stopped():
     m = quiet_model()
     stalled = Truth(port_cmd_pct=100.0, port_current_a=60.0, port_track_speed_mps=0.0,
                     stbd_cmd_pct=100.0, stbd_current_a=60.0, stbd_track_speed_mps=1.0)
-    tracks = of(DrivetrainReading, run(m, stalled, 3.0), 'tracks')
+    tracks = of(DriveStatus, run(m, stalled, 3.0), 'tracks')
     stall_time = PARAMS['motors.stall_time_s']
     flagged = [r.t_s for r in tracks if r.port.fault_flags & Fault.STALL]
     assert flagged and flagged[0] == pytest.approx(stall_time, abs=0.06)
@@ -214,7 +215,7 @@ def test_stall_fault_after_the_stall_time_with_the_belt_stopped():
 
 def test_overheat_and_undervoltage_faults():
     hot = quiet_model(**{'motors.thermal_tau_s': 1.0})
-    tracks = of(DrivetrainReading, run(hot, Truth(port_current_a=70.0), 6.0), 'tracks')
+    tracks = of(DriveStatus, run(hot, Truth(port_current_a=70.0), 6.0), 'tracks')
     assert tracks[0].port.temperature_c == pytest.approx(PARAMS['motors.ambient_temp_c'])
     assert tracks[-1].port.temperature_c > PARAMS['motors.overheat_c']
     assert tracks[-1].port.fault_flags & Fault.OVERHEAT
