@@ -113,28 +113,29 @@ def test_a_drive_status_must_say_its_drive():
 
 def test_the_estimator_sees_the_same_in_process_and_over_ros():
     """evaluate / the stack harness feed readings directly, ekf_node the messages: one rule."""
+    from dukw_common.config import node_params
+    from dukw_common.readings import reading_topic
     from dukw_common.vehicle import Vehicle
-    from dukw_estimation.evaluate import build_estimator
-    from dukw_estimation.feed import feed
+    from dukw_estimation.runner import EkfRunner
     from dukw_sim.core import Actuation, SimCore
     from dukw_sim.sensors import SensorModel
     sim = SimCore.from_config(seed=5)
     sim.reset('sand', yaw_rad=0.5)
     sensors = SensorModel.from_config(seed=5)
-    gps = sensors.config.gps
-    datum = (gps.datum_lat_deg, gps.datum_lon_deg, gps.datum_alt_m)
-    direct, over_ros = (build_estimator(sim.vehicle, datum) for _ in range(2))
+    direct, over_ros = (EkfRunner.from_params(node_params('ekf_node'), vehicle=sim.vehicle)
+                        for _ in range(2))
+    direct_est, ros_est = direct.estimator, over_ros.estimator
     assert isinstance(sim.vehicle, Vehicle)
     for _ in range(300):
         truth = sim.step(Actuation(80.0, 60.0, 0.0, 0.0))
         for reading in sensors.sample(truth):
-            feed(direct, reading)
-            feed(over_ros, round_trip(reading))
-    a, b = direct.odometry(), over_ros.odometry()
+            direct.on_sample(reading_topic(reading), reading, truth.t_s)
+            over_ros.on_sample(reading_topic(reading), round_trip(reading), truth.t_s)
+    a, b = direct_est.odometry(), ros_est.odometry()
     assert (b.x_m, b.y_m, b.yaw_rad, b.surge_mps) == pytest.approx(
         (a.x_m, a.y_m, a.yaw_rad, a.surge_mps), abs=1e-9)
     assert a.surge_mps > 0.3                       # it really drove
-    ta, tb = direct.traction(), over_ros.traction()
+    ta, tb = direct_est.traction(), ros_est.traction()
     assert (tb.port_slip, tb.weight_on_tracks_fraction) == pytest.approx(
         (ta.port_slip, ta.weight_on_tracks_fraction), abs=1e-9)
-    assert direct.counters == over_ros.counters
+    assert direct_est.counters == ros_est.counters

@@ -33,6 +33,7 @@ setup(
             'record = dukw_bringup.record:main',
             'play = dukw_bringup.play:main',
             'replay = dukw_bringup.replay:main',
+            'evaluate = dukw_bringup.evaluate:main',
             # randomized runs on Dask (issue 18)
             'campaign = dukw_bringup.campaign_cli:main',
         ],

@@ -21,7 +21,6 @@ setup(
         'console_scripts': [
             'ekf_node = dukw_estimation.ekf_node:main',
             'fit_terrain = dukw_estimation.fit_terrain:main',
-            'evaluate = dukw_estimation.evaluate:main',
             'sysid = dukw_estimation.sysid_cli:main',
         ],
     },

@@ -141,15 +141,22 @@ class Stack:
         self.record = Record()
         self.listeners: list[Callable[[str, int, Any], None]] = []
 
+    def place(self, start: str = 'sand', x_m: float | None = None,
+              yaw_rad: float = 0.0) -> Truth:
+        """Put the vehicle at its start (before the first step; SimCore.reset's arguments)."""
+        self.truth = self.sim.reset(start, x_m, yaw_rad)
+        return self.truth
+
     # --- publication and delivery ------------------------------------------------------
     def publish(self, topic: str, t_ns: int, item: Any) -> None:
-        """Put ``item`` on ``topic`` at ``t_ns`` and deliver it to its subscribers."""
+        """Put ``item`` on ``topic`` at ``t_ns``, deliver it to its subscribers, then tell
+        the listeners (observers: evaluation, recording)."""
         item = self.wire.carry(topic, t_ns, item)
-        for listen in self.listeners:
-            listen(topic, t_ns, item)
         deliver = self._ROUTES.get(topic)
         if deliver is not None:
             deliver(self, topic, t_ns, item)
+        for listen in self.listeners:
+            listen(topic, t_ns, item)
 
     def _sample(self, topic: str, t_ns: int, sample) -> None:
         t_s = t_ns * 1e-9

@@ -1,11 +1,12 @@
 """evaluate: the estimator's accuracy on simulator runs, offline (no DDS).
 
-Each scenario runs the simulator core (dukw_sim.core.SimCore) with its seeded sensor
-model (dukw_sim.sensors.SensorModel), feeds the readings - never the truth - through the
-estimator core, and scores the estimates against the truth. One JSON object per scenario:
+Each scenario runs the in-process stack (dukw_bringup.stack_harness: the simulator core,
+its seeded sensor models and the EKF runner as ekf_node runs it) with fixed actuation:
+the readings - never the truth - go through the estimator, whose estimates are scored
+against the truth. One JSON object per scenario:
 
-    install/lib/dukw_estimation/evaluate [--scenario NAME ...] [--duration S] [--seed N]
-                                         [--oracle-surface]
+    install/lib/dukw_bringup/evaluate [--scenario NAME ...] [--duration S] [--seed N]
+                                      [--oracle-surface]
 
 ``--oracle-surface`` is a diagnostic: the estimator is handed the true waterline distance
 and wave elevation at base_link before every output, so what is left of the submersion
@@ -17,7 +18,6 @@ volume <= 10 % of the full displacement volume, weight-on-tracks fraction <= 0.1
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import math
 import sys
@@ -26,11 +26,10 @@ from typing import Sequence
 
 import numpy as np
 
-from dukw_common.config import ConfigError, node_params
-from dukw_common.vehicle import Vehicle, soil_params
-from dukw_estimation.estimator import Estimator
-from dukw_estimation.feed import feed
-from dukw_estimation.settings import EkfSettings
+from dukw_bringup.stack_harness import SENSOR_TOPICS, ClosedLoop
+from dukw_common.config import ConfigError
+from dukw_common.vehicle import Vehicle
+from dukw_sim.core import Actuation
 
 TARGETS = {'position_rmse_m': 0.5, 'heading_rmse_deg': 3.0, 'slip_rmse': 0.05,
            'volume_error_pct': 10.0, 'fraction_error': 0.1}
@@ -72,49 +71,40 @@ def _wave_overrides(height_m: float) -> dict:
     return {'waves.model': 'irregular', 'waves.significant_height_m': height_m}
 
 
-def build_estimator(vehicle: Vehicle, datum: tuple[float, float, float],
-                    config: str | None = None) -> Estimator:
-    """The estimator as ekf_node configures it, its datum the simulator's survey origin."""
-    params = node_params('ekf_node', config)
-    settings = dataclasses.replace(EkfSettings.from_params(params), datum_from_first_fix=False,
-                                   datum_latitude_deg=datum[0], datum_longitude_deg=datum[1],
-                                   datum_altitude_m=datum[2])
-    return Estimator(vehicle, settings, soil_params(params, settings.soil_preset or None))
+def _place(stack: ClosedLoop, scenario: Scenario) -> None:
+    sim = stack.sim
+    vehicle = sim.vehicle
+    if scenario.start == 'flat':
+        stack.place(x_m=sim.params.world.flat_start_x_m - LAND_CLEARANCE_M,
+                    yaw_rad=scenario.yaw_rad)
+    elif scenario.start == 'sea':
+        depth = vehicle.body.draft_m + SEA_TO_LAND_CLEARANCE_M
+        stack.place(x_m=depth / math.tan(vehicle.site.beach_slope_rad), yaw_rad=scenario.yaw_rad)
+    else:
+        stack.place(scenario.start, yaw_rad=scenario.yaw_rad)
 
 
 def run_scenario(scenario: Scenario, duration_s: float = 30.0, seed: int = 0,
                  config: str | None = None, oracle_surface: bool = False) -> dict:
-    """Run one scenario; return its metrics (and whether each target is met).
+    """Run one scenario on the in-process stack with fixed actuation; its metrics.
 
     ``oracle_surface``: pin the estimator's waterline distance and wave to the truth's after
-    every reading (a diagnostic of where the submersion error comes from).
+    every sensor reading (a diagnostic of where the submersion error comes from).
     """
-    from dukw_sim.core import Actuation, SimCore
-    from dukw_sim.sensors import SensorModel
-    sim = SimCore.from_config(config, overrides=_wave_overrides(scenario.wave_height_m),
-                              seed=seed)
-    sensors = SensorModel.from_config(config, seed=seed)
-    vehicle = sim.vehicle
-    if scenario.start == 'flat':
-        sim.reset(x_m=sim.params.world.flat_start_x_m - LAND_CLEARANCE_M,
-                  yaw_rad=scenario.yaw_rad)
-    elif scenario.start == 'sea':
-        depth = vehicle.body.draft_m + SEA_TO_LAND_CLEARANCE_M
-        sim.reset(x_m=depth / math.tan(vehicle.site.beach_slope_rad), yaw_rad=scenario.yaw_rad)
-    else:
-        sim.reset(scenario.start, yaw_rad=scenario.yaw_rad)
-    gps = sensors.config.gps
-    est = build_estimator(vehicle, (gps.datum_lat_deg, gps.datum_lon_deg, gps.datum_alt_m),
-                          config)
     act = Actuation(*scenario.tracks_pct, *scenario.props_pct)
+    stack = ClosedLoop(_wave_overrides(scenario.wave_height_m), seed=seed, feedback='ekf',
+                       config=config, actuation=act)
+    _place(stack, scenario)
+    est = stack.est
+    if oracle_surface:
+        def pin(topic: str, t_ns: int, item) -> None:
+            if topic in SENSOR_TOPICS:
+                est.pin_surface(stack.truth.waterline_distance_m, stack.truth.wave_elevation_m)
+        stack.listeners.append(pin)
     rows = []
-    truth = sim.truth
-    for _ in range(int(round(duration_s / sim.dt_s))):
-        truth = sim.step(act)
-        for reading in sensors.sample(truth):
-            feed(est, reading)
-            if oracle_surface:
-                est.pin_surface(truth.waterline_distance_m, truth.wave_elevation_m)
+    truth = stack.truth
+    for _ in range(int(round(duration_s / stack.sim.dt_s))):
+        truth = stack.step()
         if truth.t_s < WARM_UP_S or est.t_s is None:
             continue
         odo, trc = est.odometry(), est.traction()
@@ -125,7 +115,7 @@ def run_scenario(scenario: Scenario, duration_s: float = 30.0, seed: int = 0,
                      abs(truth.stbd_track_speed_mps) > MOVING_TRACK_MPS,
                      trc.submerged_volume_m3 - truth.submerged_volume_m3,
                      trc.weight_on_tracks_fraction - truth.weight_on_tracks_fraction))
-    result = score(scenario, np.array(rows, dtype=float), vehicle, truth, est)
+    result = score(scenario, np.array(rows, dtype=float), stack.sim.vehicle, truth, est)
     if oracle_surface:
         result['oracle'] = 'surface'
     return result

@@ -3,7 +3,7 @@ import json
 
 import pytest
 
-from dukw_estimation import evaluate
+from dukw_bringup import evaluate
 
 DURATION_S = 20.0      # shorter than the tool's 30 s default: every transition is complete by then
 MOTION = ('position_rmse_m', 'heading_rmse_deg', 'slip_rmse')
