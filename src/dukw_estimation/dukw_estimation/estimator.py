@@ -28,7 +28,6 @@ MAX_PREDICT_STEP_S = 0.02
 GROUNDED_FRACTION = 0.5          # above this weight share the tracks drive the vehicle
 SLOPE_FRACTION = 0.9             # above this share the pitch is the beach's, not the waves'
 TOUCHDOWN_SHARE = 0.8           # afloat until the mean-surface volume drops below this share
-FRACTION_PERIOD_S = 0.1          # how often the IMU path refreshes the weight share
 SECANT_STEPS_M = (0.005, 0.02, 0.05, 0.1, 0.2)   # surface steps of the force's derivative
 
 
@@ -95,7 +94,6 @@ class Estimator:
         self.motion = 0.0                # > 1: rolling, pitching, heaving like a floating hull
         self._heave_mean_mps2 = 0.0      # slow mean of the heave acceleration (tilt, bias)
         self.heave_velocity_mps = 0.0
-        self._fraction_t_s = -math.inf
         self._force_update_t = -math.inf
         self._grounded_since_s = math.inf
         self.force = [ForceSmoother(st.force_process_n_per_s, st.force_measurement_n)
@@ -109,6 +107,7 @@ class Estimator:
                           self.settings.init_yaw_rad)
         self._init_waterline()
         self.position_set = self.yaw_set = True
+        self._refresh_contact()
         return True
 
     def pin_surface(self, waterline_distance_m: float, wave_elevation_m: float) -> bool:
@@ -118,6 +117,7 @@ class Estimator:
             return False
         self.ekf.x[Idx.S] = waterline_distance_m
         self.ekf.x[Idx.ETA] = wave_elevation_m
+        self._refresh_contact()
         return True
 
     def _init_waterline(self) -> None:
@@ -145,7 +145,12 @@ class Estimator:
         return t_s - self.last_t[sensor] <= self.settings.sensor_timeout_s
 
     def advance(self, t_s: float) -> None:
-        """Predict the filter forward to ``t_s`` (no-op when ``t_s`` is not newer)."""
+        """Predict the filter forward to ``t_s`` (no-op when ``t_s`` is not newer) and
+        refresh the contact decision for the predicted state."""
+        self._predict_to(t_s)
+        self._refresh_contact()
+
+    def _predict_to(self, t_s: float) -> None:
         if self.t_s is None:
             self.t_s = t_s
             return
@@ -198,7 +203,7 @@ class Estimator:
         too_old = self.t_s is not None and t_s < self.t_s - self.settings.max_lag_s
         if t_s <= self.last_t[sensor] or too_old:
             return self._count(sensor, Outcome.REJECTED_OUT_OF_ORDER)
-        self.advance(t_s)
+        self._predict_to(t_s)
         self.last_t[sensor] = t_s
         self.rates[sensor].tick(t_s)
         return None
@@ -206,6 +211,11 @@ class Estimator:
     def _count(self, sensor: str, outcome: Outcome) -> Outcome:
         self.counters[sensor][outcome] += 1
         return outcome
+
+    def _settle(self, sensor: str, outcome: Outcome) -> Outcome:
+        """After an admitted sample: the contact decision follows the new state."""
+        self._refresh_contact()
+        return self._count(sensor, outcome)
 
     # ------------------------------------------------------------------ sensors
     def add_imu(self, s: ImuSample) -> Outcome:
@@ -236,6 +246,7 @@ class Estimator:
                                              st.gate_imu, angle=True)
             if yaw_out is not Outcome.ACCEPTED:
                 out = yaw_out
+        self._refresh_contact()
         self._update_slope(s, dt)
         return self._count('imu', out)
 
@@ -290,8 +301,6 @@ class Estimator:
 
     def _update_slope(self, s: ImuSample, dt: float) -> None:
         """Low-pass the beach slope along the seaward direction from pitch and roll."""
-        if s.t_s - self._fraction_t_s >= FRACTION_PERIOD_S:
-            self.traction()          # refreshes the weight share
         if self.fraction <= SLOPE_FRACTION:
             return
         rel = self.ekf.x[Idx.YAW] - self.settings.seaward_yaw_rad
@@ -341,7 +350,7 @@ class Estimator:
         predicted = x[[Idx.X, Idx.Y]] + offset + x[[Idx.GPS_BIAS_E, Idx.GPS_BIAS_N]]
         out = self.ekf.update(np.array([east, north]), predicted, H, np.eye(2) * var,
                               self.settings.gate_gps_fix)
-        return self._count('gps_fix', out)
+        return self._settle('gps_fix', out)
 
     def add_gps_velocity(self, s: GpsVelocity) -> Outcome:
         """DGPS ground velocity of the antenna (ENU); corrects u, v and yaw."""
@@ -360,7 +369,7 @@ class Estimator:
         out = self.ekf.update(np.array([s.east_mps, s.north_mps]),
                               np.array([c * ub - sn * vb, sn * ub + c * vb]), H,
                               np.eye(2) * var, self.settings.gate_gps_vel)
-        return self._count('gps_vel', out)
+        return self._settle('gps_vel', out)
 
     def add_water_contact(self, s: WaterContact) -> Outcome:
         """Wet/dry sensors: where the state disagrees, the surface is at the sensor."""
@@ -369,7 +378,7 @@ class Estimator:
             return rejected
         if self.afloat:
             # floating, the sensors ride with the hull, not at a height above the sand
-            return self._count('water', Outcome.ACCEPTED)
+            return self._settle('water', Outcome.ACCEPTED)
         mounts = self.vehicle.sensors
         out = Outcome.IGNORED
         for wet, x_m, z_m in ((s.fore_wet, mounts.fore_water_x_m, mounts.fore_water_z_m),
@@ -383,7 +392,7 @@ class Estimator:
                 out = result
         if out is Outcome.IGNORED:
             out = Outcome.ACCEPTED    # consistent with the state: nothing to correct
-        return self._count('water', out)
+        return self._settle('water', out)
 
     def _sensor_depth(self, x_m: float, z_m: float) -> tuple[float, np.ndarray]:
         """Water over a sensor at body (x, z) of a vehicle on the slope, and its Jacobian."""
@@ -401,7 +410,7 @@ class Estimator:
         """A valid sounding means the transducer floats above the sea bed: corrects s, eta."""
         if not s.valid:
             rejected = self._admit('depth', s.t_s, ())
-            return rejected or self._count('depth', Outcome.IGNORED)
+            return rejected or self._settle('depth', Outcome.IGNORED)
         rejected = self._admit('depth', s.t_s, (s.depth_m,))
         if rejected:
             return rejected
@@ -417,7 +426,7 @@ class Estimator:
         predicted = x[Idx.ETA] - body.draft_m + mounts.depth_sounder_z_m + floor_depth
         out = self.ekf.update_scalar(s.depth_m, predicted, h, self.settings.depth_m ** 2,
                                      self.settings.gate_depth, only=WATERLINE_STATE)
-        return self._count('depth', out)
+        return self._settle('depth', out)
 
     def add_tracks(self, s: DriveStatus) -> Outcome:
         """Track speeds (slip, drive model) and measured forces (smoothed)."""
@@ -433,7 +442,7 @@ class Estimator:
         if not self._fresh('gps_vel', s.t_s) and self.fraction > GROUNDED_FRACTION:
             self._track_odometry(s)
         self._track_force_update(s)
-        return self._count('tracks', Outcome.ACCEPTED)
+        return self._settle('tracks', Outcome.ACCEPTED)
 
     def _track_force_update(self, s: DriveStatus) -> None:
         """The smoothed track forces against the Wong force of the estimated weight: a
@@ -543,7 +552,7 @@ class Estimator:
         if rejected:
             return rejected
         self.props = s
-        return self._count('props', Outcome.ACCEPTED)
+        return self._settle('props', Outcome.ACCEPTED)
 
     # ------------------------------------------------------------------ outputs
     def odometry(self) -> OdometryEstimate:
@@ -567,24 +576,17 @@ class Estimator:
                                 float(x[Idx.R]), pose_cov, twist_cov)
 
     def traction(self) -> TractionEstimate:
-        """Slip per track, submersion (h2, volume, W_e, weight share) and track forces."""
+        """Slip per track, submersion (h2, volume, W_e, weight share) and track forces.
+
+        A pure query: the afloat / sand decision is the one the last sample (or
+        ``advance``) made; the volume and weight follow the present state."""
         x = self.ekf.x
         body = self.vehicle.body
-        slope = self.slope_rad
-        heading_cos = math.cos(x[Idx.YAW] - self.settings.seaward_yaw_rad)
-        args = (x[Idx.S], slope, body.hull_clearance_m, self.hull_bow_x_m, self.hull_stern_x_m)
-        h2 = buoyancy.submerged_length_m(*args, x[Idx.ETA], heading_cos)
-        volume = buoyancy.grounded_volume_m3(*args, body.hull_radius_m, x[Idx.ETA], heading_cos,
-                                             self.section)
-        afloat = self.afloat = self._floating(volume)
-        if afloat:
-            volume = self._afloat_volume()
-        else:
-            volume = min(volume, body.displaced_volume_m3)   # on the sand: it does not float
-        weight = 0.0 if afloat else traction.effective_weight_n(
-            body.displacement_n, volume, slope, body.water_density_kgpm3, body.gravity_mps2)
-        self.fraction = weight / (body.displacement_n * math.cos(slope))
-        self._fraction_t_s = self.t_s or 0.0
+        h2, grounded = self._submersion()
+        afloat = self.afloat
+        volume = self._afloat_volume() if afloat else min(grounded, body.displaced_volume_m3)
+        weight = self._weight_n(grounded, afloat)
+        fraction = weight / (body.displacement_n * math.cos(self.slope_rad))
         ground = self._ground_speeds()
         slips = [math.nan, math.nan]
         predicted = [math.nan, math.nan]
@@ -596,10 +598,39 @@ class Estimator:
                                                       self.soil, self.track_area_m2,
                                                       body.track_contact_length_m)
         return TractionEstimate(self.t_s or 0.0, slips[0], slips[1], volume, weight,
-                                self.fraction, float(x[Idx.S]), h2, slope, predicted[0],
+                                fraction, float(x[Idx.S]), h2, self.slope_rad, predicted[0],
                                 predicted[1], self._measured_soil_force_n(0),
                                 self._measured_soil_force_n(1),
                                 afloat, float(x[Idx.ETA]))
+
+    def _submersion(self) -> tuple[float, float]:
+        """(h2, the volume the estimated surface puts under water on the slope), m, m^3."""
+        x = self.ekf.x
+        body = self.vehicle.body
+        heading_cos = math.cos(x[Idx.YAW] - self.settings.seaward_yaw_rad)
+        args = (x[Idx.S], self.slope_rad, body.hull_clearance_m, self.hull_bow_x_m,
+                self.hull_stern_x_m)
+        h2 = buoyancy.submerged_length_m(*args, x[Idx.ETA], heading_cos)
+        volume = buoyancy.grounded_volume_m3(*args, body.hull_radius_m, x[Idx.ETA], heading_cos,
+                                             self.section)
+        return h2, volume
+
+    def _weight_n(self, grounded_volume_m3: float, afloat: bool) -> float:
+        """Weight on the tracks, N: none afloat; on the sand the hulls do not float."""
+        body = self.vehicle.body
+        if afloat:
+            return 0.0
+        return traction.effective_weight_n(
+            body.displacement_n, min(grounded_volume_m3, body.displaced_volume_m3),
+            self.slope_rad, body.water_density_kgpm3, body.gravity_mps2)
+
+    def _refresh_contact(self) -> None:
+        """Decide afloat or on the sand and the weight share for the present state: after
+        each sample and ``advance`` (never in a query, so asking changes nothing)."""
+        _, grounded = self._submersion()
+        self.afloat = self._floating(grounded)
+        self.fraction = self._weight_n(grounded, self.afloat) / (
+            self.vehicle.body.displacement_n * math.cos(self.slope_rad))
 
     def _floating(self, grounded_volume_m3: float) -> bool:
         """Afloat or on the sand: the IMU's motion test when fresh, else the geometry.

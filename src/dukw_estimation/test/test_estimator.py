@@ -407,3 +407,58 @@ def test_afloat_volume_counts_the_heave_damping_force():
     with_damping = _heaving_afloat(make())
     assert with_damping < 0.01
     assert _heaving_afloat(make(heave_velocity_tau_s=0.1)) > 2 * with_damping
+
+
+def _surf_samples():
+    """A vehicle 6 m out in the surf: lying still, then rolling and heaving like a hull
+    afloat, then still again, with fixes, tracks pushing and wet/dry sensors (the afloat /
+    sand decision changes twice)."""
+    slope = VEHICLE.site.beach_slope_rad
+    samples = []
+    for k in range(400):
+        t = (k + 1) * 0.01
+        w = 0.5 * math.sin(2 * math.pi * 0.4 * t) if 100 <= k < 300 else 0.0
+        samples.append(('add_imu', ImuSample(t, 0.1 * w, slope, 0.0, w, 0.0, 0.0,
+                                             -G * math.sin(slope), 0.0, G + 2.0 * w)))
+        if k % 10 == 0:
+            samples.append(('add_gps_fix', fix(t, 6.0, 0.0)))
+            samples.append(('add_gps_velocity', GpsVelocity(t, 0.0, 0.0)))
+        if k % 5 == 0:
+            samples.append(('add_tracks', tracks(t, 0.3, 0.3, 150.0 if k < 100 else 20.0)))
+            samples.append(('add_water_contact', WaterContact(t, True, k % 20 == 0)))
+    return samples
+
+
+def _run_asking(queries_between_samples):
+    est = make(wave_sigma_m=0.05)
+    seen = []
+    for method, sample in _surf_samples():
+        getattr(est, method)(sample)
+        for _ in range(queries_between_samples):
+            seen.append((est.odometry(), est.traction()))
+    est.advance(est.t_s + 0.05)
+    return est, seen
+
+
+def _same(a, b):
+    for name in a.__dataclass_fields__:
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+
+
+def test_asking_for_the_estimate_changes_nothing():
+    """odometry() and traction() are pure: asking 0, 1 or 5 times after every sample gives
+    the same filter, the same final estimate, and the same answers on the way."""
+    silent, _ = _run_asking(0)
+    once, seen_once = _run_asking(1)
+    often, seen_often = _run_asking(5)
+    assert any(t.afloat for _, t in seen_once) and not seen_once[-1][1].afloat
+    for est in (once, often):
+        np.testing.assert_array_equal(est.ekf.x, silent.ekf.x)
+        np.testing.assert_array_equal(est.ekf.P, silent.ekf.P)
+        _same(est.odometry(), silent.odometry())
+        _same(est.traction(), silent.traction())
+    assert len(seen_often) == 5 * len(seen_once)
+    for k, (odometry, traction_) in enumerate(seen_once):
+        for odometry_again, traction_again in seen_often[5 * k:5 * k + 5]:
+            _same(odometry_again, odometry)
+            _same(traction_again, traction_)
