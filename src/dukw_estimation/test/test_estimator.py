@@ -288,8 +288,9 @@ def _surf_run(est, true_surface_m, slip_, seconds=5.0, x0=5.0, track_mps=0.5):
         est.add_imu(imu(t, 0.0, 0.0, pitch=slope))
         s_true = x / math.cos(slope)
         volume = min(buoyancy.grounded_volume_m3(
-            s_true, slope, body.hull_clearance_m, est.contact.hull_bow_x_m, est.contact.hull_stern_x_m,
-            body.hull_radius_m, true_surface_m, 1.0, section), body.displaced_volume_m3)
+            s_true, slope, body.hull_clearance_m, est.contact.hull_bow_x_m,
+            est.contact.hull_stern_x_m, body.hull_radius_m, true_surface_m, 1.0, section),
+            body.displaced_volume_m3)
         weight = traction.effective_weight_n(body.displacement_n, volume, slope,
                                              body.water_density_kgpm3, G)
         fraction = weight / (body.displacement_n * math.cos(slope))
@@ -297,7 +298,8 @@ def _surf_run(est, true_surface_m, slip_, seconds=5.0, x0=5.0, track_mps=0.5):
             est.add_gps_fix(fix(t, x, 0.0))
             est.add_gps_velocity(GpsVelocity(t, u * math.cos(slope), 0.0))
         if k % 5 == 0:
-            soil_n = traction.tractive_force_n(slip_, 0.5 * weight, soil, est.contact.track_area_m2,
+            soil_n = traction.tractive_force_n(slip_, 0.5 * weight, soil,
+                                               est.contact.track_area_m2,
                                                body.track_contact_length_m)
             sides = []
             for port in (True, False):    # the motors also turn the drivetrain
