@@ -288,8 +288,9 @@ def _surf_run(est, true_surface_m, slip_, seconds=5.0, x0=5.0, track_mps=0.5):
         est.add_imu(imu(t, 0.0, 0.0, pitch=slope))
         s_true = x / math.cos(slope)
         volume = min(buoyancy.grounded_volume_m3(
-            s_true, slope, body.hull_clearance_m, est.hull_bow_x_m, est.hull_stern_x_m,
-            body.hull_radius_m, true_surface_m, 1.0, section), body.displaced_volume_m3)
+            s_true, slope, body.hull_clearance_m, est.contact.hull_bow_x_m,
+            est.contact.hull_stern_x_m, body.hull_radius_m, true_surface_m, 1.0, section),
+            body.displaced_volume_m3)
         weight = traction.effective_weight_n(body.displacement_n, volume, slope,
                                              body.water_density_kgpm3, G)
         fraction = weight / (body.displacement_n * math.cos(slope))
@@ -297,7 +298,8 @@ def _surf_run(est, true_surface_m, slip_, seconds=5.0, x0=5.0, track_mps=0.5):
             est.add_gps_fix(fix(t, x, 0.0))
             est.add_gps_velocity(GpsVelocity(t, u * math.cos(slope), 0.0))
         if k % 5 == 0:
-            soil_n = traction.tractive_force_n(slip_, 0.5 * weight, soil, est.track_area_m2,
+            soil_n = traction.tractive_force_n(slip_, 0.5 * weight, soil,
+                                               est.contact.track_area_m2,
                                                body.track_contact_length_m)
             sides = []
             for port in (True, False):    # the motors also turn the drivetrain
@@ -333,10 +335,10 @@ def test_track_forces_of_nearly_stopped_tracks_are_not_used():
     """Crawling at 0.1 m/s the slip is the ground-speed error over the track speed: no news."""
     slow = make(wave_sigma_m=0.07, waterline_sigma_m=0.05)
     _surf_run(slow, -0.06, 0.4, seconds=1.0, track_mps=0.1)
-    assert slow._force_update_t == -math.inf              # never used
+    assert slow.surface.force_update_t_s == -math.inf              # never used
     turning = make(wave_sigma_m=0.07, waterline_sigma_m=0.05)
     _surf_run(turning, -0.06, 0.4, seconds=1.0, track_mps=0.5)
-    assert turning._force_update_t > 0.5
+    assert turning.surface.force_update_t_s > 0.5
 
 
 def test_tracks_pushing_under_a_hull_thought_afloat_bring_the_weight_back():
@@ -355,27 +357,27 @@ def test_tracks_pushing_under_a_hull_thought_afloat_bring_the_weight_back():
 
 
 def test_both_tracks_pushing_hard_mean_the_sand_even_when_the_imu_rolls():
-    est = make()
-    est.motion = 5.0                     # the IMU's motion test says: floating
-    est.t_s = 1.0
-    est.last_t['tracks'] = 1.0
-    est.tracks = tracks(1.0, 1.0, 1.0)
+    contact = make().contact
+    contact.motion_level = 5.0           # the IMU's motion test says: floating
+    status = tracks(1.0, 1.0, 1.0)
     drive = VEHICLE.drivetrain
-    for k, smoother in enumerate(est.force):
+    for k, smoother in enumerate(contact.force):
         smoother.update(1.0, drive.track_friction_n(k == 0) + 200.0)
-    assert est._tracks_pushing()
-    assert not est._floating(VEHICLE.body.displaced_volume_m3 * 1.1)
-    for k, smoother in enumerate(est.force):     # paddling: the friction and a little more
+    assert contact.tracks_pushing(status, True)
+    assert not contact.tracks_pushing(status, False)    # a stale status says nothing
+    volume = VEHICLE.body.displaced_volume_m3 * 1.1
+    assert not contact.floating(volume, True, contact.tracks_pushing(status, True))
+    for k, smoother in enumerate(contact.force):     # paddling: the friction and a little more
         smoother.kf.x[0, 0] = drive.track_friction_n(k == 0) + 20.0
-    assert not est._tracks_pushing()
-    assert est._floating(VEHICLE.body.displaced_volume_m3 * 1.1)
-    est.tracks = tracks(1.0, 0.0, 0.0)          # held belts braking a vehicle on the sand
-    for smoother in est.force:
+    assert not contact.tracks_pushing(status, True)
+    assert contact.floating(volume, True, contact.tracks_pushing(status, True))
+    held = tracks(1.0, 0.0, 0.0)                # held belts braking a vehicle on the sand
+    for smoother in contact.force:
         smoother.kf.x[0, 0] = -120.0
-    assert est._tracks_pushing()
-    for smoother in est.force:                  # held belts dragged through the water
+    assert contact.tracks_pushing(held, True)
+    for smoother in contact.force:              # held belts dragged through the water
         smoother.kf.x[0, 0] = -10.0
-    assert not est._tracks_pushing()
+    assert not contact.tracks_pushing(held, True)
 
 
 def _heaving_afloat(est, seconds=12.0, amplitude_m=0.1, hz=0.3):
@@ -395,8 +397,8 @@ def _heaving_afloat(est, seconds=12.0, amplitude_m=0.1, hz=0.3):
         if t > seconds - 4.0:
             out = est.traction()
             assert out.afloat
-            truth = (body.displacement_n + est.heave_mass_kg * accel
-                     + est.heave_damping_n_per_mps * velocity) / rho_g
+            truth = (body.displacement_n + est.contact.heave_mass_kg * accel
+                     + est.contact.heave_damping_n_per_mps * velocity) / rho_g
             errors.append((out.submerged_volume_m3 - truth) / body.displaced_volume_m3)
     return float(np.sqrt(np.mean(np.square(errors))))
 
@@ -407,3 +409,58 @@ def test_afloat_volume_counts_the_heave_damping_force():
     with_damping = _heaving_afloat(make())
     assert with_damping < 0.01
     assert _heaving_afloat(make(heave_velocity_tau_s=0.1)) > 2 * with_damping
+
+
+def _surf_samples():
+    """A vehicle 6 m out in the surf: lying still, then rolling and heaving like a hull
+    afloat, then still again, with fixes, tracks pushing and wet/dry sensors (the afloat /
+    sand decision changes twice)."""
+    slope = VEHICLE.site.beach_slope_rad
+    samples = []
+    for k in range(400):
+        t = (k + 1) * 0.01
+        w = 0.5 * math.sin(2 * math.pi * 0.4 * t) if 100 <= k < 300 else 0.0
+        samples.append(('add_imu', ImuSample(t, 0.1 * w, slope, 0.0, w, 0.0, 0.0,
+                                             -G * math.sin(slope), 0.0, G + 2.0 * w)))
+        if k % 10 == 0:
+            samples.append(('add_gps_fix', fix(t, 6.0, 0.0)))
+            samples.append(('add_gps_velocity', GpsVelocity(t, 0.0, 0.0)))
+        if k % 5 == 0:
+            samples.append(('add_tracks', tracks(t, 0.3, 0.3, 150.0 if k < 100 else 20.0)))
+            samples.append(('add_water_contact', WaterContact(t, True, k % 20 == 0)))
+    return samples
+
+
+def _run_asking(queries_between_samples):
+    est = make(wave_sigma_m=0.05)
+    seen = []
+    for method, sample in _surf_samples():
+        getattr(est, method)(sample)
+        for _ in range(queries_between_samples):
+            seen.append((est.odometry(), est.traction()))
+    est.advance(est.t_s + 0.05)
+    return est, seen
+
+
+def _same(a, b):
+    for name in a.__dataclass_fields__:
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+
+
+def test_asking_for_the_estimate_changes_nothing():
+    """odometry() and traction() are pure: asking 0, 1 or 5 times after every sample gives
+    the same filter, the same final estimate, and the same answers on the way."""
+    silent, _ = _run_asking(0)
+    once, seen_once = _run_asking(1)
+    often, seen_often = _run_asking(5)
+    assert any(t.afloat for _, t in seen_once) and not seen_once[-1][1].afloat
+    for est in (once, often):
+        np.testing.assert_array_equal(est.ekf.x, silent.ekf.x)
+        np.testing.assert_array_equal(est.ekf.P, silent.ekf.P)
+        _same(est.odometry(), silent.odometry())
+        _same(est.traction(), silent.traction())
+    assert len(seen_often) == 5 * len(seen_once)
+    for k, (odometry, traction_) in enumerate(seen_once):
+        for odometry_again, traction_again in seen_often[5 * k:5 * k + 5]:
+            _same(odometry_again, odometry)
+            _same(traction_again, traction_)

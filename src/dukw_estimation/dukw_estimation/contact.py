@@ -1,0 +1,231 @@
+"""Contact and submersion: afloat or on the sand, the hulls' volume, the weight on the tracks.
+
+ROS-free. The motion filter (``motion_filter.MotionFilter``) estimates where the vehicle
+and the water surface are; this model turns that into what the hulls displace and what the
+sand carries (vehicle.md 6), and decides afloat / on the sand from the IMU's motion test,
+the track forces and the geometry. Its state (the decision, the weight share, the IMU's
+motion and heave filters, the smoothed track forces, the beach slope) changes only when
+a sample arrives or the filter advances (``Estimator``), never when someone asks.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from dukw_common.vehicle import SoilParams, Vehicle
+from dukw_estimation import buoyancy, traction
+from dukw_estimation.ekf import Idx
+from dukw_estimation.force_filter import ForceSmoother
+from dukw_common.readings import DriveStatus, ImuSample
+from dukw_estimation.settings import EkfSettings
+
+MAX_IMU_STEP_S = 0.1             # IMU gaps longer than this do not feed the heave integral
+SLOPE_FRACTION = 0.9             # above this share the pitch is the beach's, not the waves'
+TOUCHDOWN_SHARE = 0.8           # afloat until the mean-surface volume drops below this share
+
+
+def ground_speeds(x: np.ndarray, hull_separation_m: float) -> tuple[float, float]:
+    """Ground speed under the port and starboard tracks, m/s, from the filter's state."""
+    half = 0.5 * hull_separation_m
+    return x[Idx.U] - x[Idx.R] * half, x[Idx.U] + x[Idx.R] * half
+
+
+class ContactModel:
+    """The afloat / sand decision and the submersion it implies (hull geometry, heave)."""
+
+    def __init__(self, vehicle: Vehicle, settings: EkfSettings, soil: SoilParams) -> None:
+        self.vehicle = vehicle
+        self.settings = settings
+        self.soil = soil
+        body = vehicle.body
+        # the hull cylinders: waterline length centred on base_link (under the LCG), as the
+        # simulator's hull strips; inside bow_x_m .. stern_x_m of the overall length
+        self.hull_bow_x_m = min(0.5 * body.hull_length_m, body.bow_x_m)
+        self.hull_stern_x_m = max(-0.5 * body.hull_length_m, body.stern_x_m)
+        self.section = buoyancy.HullSection.of_body(body)
+        # the most the hulls can displace, deck awash
+        self.max_volume_m3 = 2.0 * self.section.max_area_m2() * body.hull_length_m
+        # lying this deep (halfway from the displacement to the deck awash) it floats, whatever
+        # the IMU says
+        self.sure_float_m3 = 0.5 * (body.displaced_volume_m3 + self.max_volume_m3)
+        self.track_area_m2 = body.track_width_m * body.track_contact_length_m
+        # the heave stiffness of the hulls' section about the float line (as the simulator's)
+        waterplane_m2 = 2.0 * self.section.heave_width_m() * body.hull_length_m
+        self.heave_mass_kg = buoyancy.heave_mass_kg(waterplane_m2,
+                                                    body.water_density_kgpm3,
+                                                    body.gravity_mps2, settings.heave_natural_hz)
+        stiffness = body.water_density_kgpm3 * body.gravity_mps2 * waterplane_m2
+        self.heave_damping_n_per_mps = 2.0 * settings.heave_damping_ratio * math.sqrt(
+            stiffness * self.heave_mass_kg)
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to the start: on the sand, all the weight on the tracks, nothing smoothed."""
+        st = self.settings
+        self.slope_rad = self.vehicle.site.beach_slope_rad
+        self.fraction = 1.0
+        self.afloat = False
+        self.motion_level = 0.0          # > 1: rolling, pitching, heaving like a floating hull
+        self._heave_mean_mps2 = 0.0      # slow mean of the heave acceleration (tilt, bias)
+        self.heave_velocity_mps = 0.0
+        self.force = [ForceSmoother(st.force_process_n_per_s, st.force_measurement_n)
+                      for _ in range(2)]
+
+    # ------------------------------------------------------------------ IMU
+    def heave_accel_mps2(self, imu: ImuSample | None,
+                         accel_base: tuple[float, float, float]) -> float:
+        """Vertical acceleration of base_link: the IMU's specific force over the tilt, less
+        g (NaN without an IMU sample)."""
+        fz = accel_base[2]
+        if imu is None or not math.isfinite(fz):
+            return math.nan
+        tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
+        return fz / max(tilt, 0.5) - self.vehicle.body.gravity_mps2
+
+    def observe_imu(self, s: ImuSample, accel_base: tuple[float, float, float],
+                    dt: float) -> None:
+        """The motion test's low-pass and the heave velocity, from one IMU sample."""
+        heave = self.heave_accel_mps2(s, accel_base)
+        self._update_motion(s, heave, dt)
+        self._update_heave_velocity(heave, dt)
+
+    def _update_motion(self, s: ImuSample, heave: float, dt: float) -> None:
+        """Low-pass of (roll/pitch rate, heave acceleration) over their thresholds, squared."""
+        st = self.settings
+        heave = heave if math.isfinite(heave) else 0.0
+        level = ((s.roll_rate_rps ** 2 + s.pitch_rate_rps ** 2) / st.contact_rate_rps ** 2
+                 + heave ** 2 / st.contact_accel_mps2 ** 2)
+        alpha = min(dt / st.contact_time_constant_s, 1.0) if dt > 0.0 else 1.0
+        self.motion_level += alpha * (level - self.motion_level)
+
+    def _update_heave_velocity(self, accel: float, dt: float) -> None:
+        """Heave velocity from the heave acceleration: its slow mean (attitude error, bias)
+        removed, then a leaky integral (heave.velocity_time_constant_s)."""
+        if not math.isfinite(accel) or not 0.0 < dt <= MAX_IMU_STEP_S:
+            return
+        tau = self.settings.heave_velocity_tau_s
+        self._heave_mean_mps2 += min(dt / (4.0 * tau), 1.0) * (accel - self._heave_mean_mps2)
+        self.heave_velocity_mps += dt * (accel - self._heave_mean_mps2) \
+            - min(dt / tau, 1.0) * self.heave_velocity_mps
+
+    def update_slope(self, s: ImuSample, yaw_rad: float, dt: float) -> None:
+        """Low-pass the beach slope along the seaward direction from pitch and roll."""
+        if self.fraction <= SLOPE_FRACTION:
+            return
+        rel = yaw_rad - self.settings.seaward_yaw_rad
+        measured = s.pitch_rad * math.cos(rel) + s.roll_rad * math.sin(rel)
+        alpha = min(dt / self.settings.slope_time_constant_s, 1.0)
+        self.slope_rad += alpha * (measured - self.slope_rad)
+
+    # ------------------------------------------------------------------ tracks
+    def smooth_track_forces(self, s: DriveStatus) -> None:
+        """Each track's force (measured, else current x gain) into its smoother."""
+        gain = self.vehicle.drivetrain.track_force_gain_n_per_a
+        for smoother, side in zip(self.force, (s.port, s.stbd), strict=True):
+            force = side.force_n if math.isfinite(side.force_n) else side.current_a * gain
+            smoother.update(s.t_s, force)
+
+    def measured_soil_force_n(self, tracks: DriveStatus | None, k: int) -> float:
+        """Track k's (0 port, 1 starboard) smoothed current x gain less the drivetrain's own
+        friction (no-load current, belt), which opposes the belt, not the sand: the soil's
+        force, N (NaN before a status). The friction fades in over the first
+        ``drivetrain.friction_fade_mps`` of belt speed, as in the simulator."""
+        force = self.force[k].force_n
+        if tracks is None or not math.isfinite(force):
+            return math.nan
+        speed = (tracks.port, tracks.stbd)[k].speed_mps
+        drive = self.vehicle.drivetrain
+        fade = math.tanh(speed / drive.friction_fade_mps)
+        return force - drive.track_friction_n(k == 0) * fade
+
+    def tracks_pushing(self, tracks: DriveStatus | None, tracks_fresh: bool) -> bool:
+        """Both tracks push or brake the vehicle harder than water could (paddling belts,
+        a held belt's drag): on the sand. From the smoothed forces less the drivetrain
+        friction, fresh status only; a held (stopped) belt braking counts as well."""
+        st = self.settings
+        if st.contact_track_force_n <= 0.0 or tracks is None or not tracks_fresh:
+            return False
+        return all(abs(self.measured_soil_force_n(tracks, k)) >= st.contact_track_force_n
+                   for k in range(2))
+
+    # ------------------------------------------------------------------ submersion
+    def submersion(self, x: np.ndarray) -> tuple[float, float]:
+        """(h2, the volume the estimated surface puts under water on the slope), m, m^3."""
+        body = self.vehicle.body
+        heading_cos = math.cos(x[Idx.YAW] - self.settings.seaward_yaw_rad)
+        args = (x[Idx.S], self.slope_rad, body.hull_clearance_m, self.hull_bow_x_m,
+                self.hull_stern_x_m)
+        h2 = buoyancy.submerged_length_m(*args, x[Idx.ETA], heading_cos)
+        volume = buoyancy.grounded_volume_m3(*args, body.hull_radius_m, x[Idx.ETA], heading_cos,
+                                             self.section)
+        return h2, volume
+
+    def weight_n(self, grounded_volume_m3: float, afloat: bool) -> float:
+        """Weight on the tracks, N: none afloat; on the sand the hulls do not float."""
+        body = self.vehicle.body
+        if afloat:
+            return 0.0
+        return traction.effective_weight_n(
+            body.displacement_n, min(grounded_volume_m3, body.displaced_volume_m3),
+            self.slope_rad, body.water_density_kgpm3, body.gravity_mps2)
+
+    def fraction_of(self, weight_n: float) -> float:
+        """The share of the weight (along the slope's normal) the tracks carry."""
+        return weight_n / (self.vehicle.body.displacement_n * math.cos(self.slope_rad))
+
+    def floating(self, grounded_volume_m3: float, imu_fresh: bool, pushing: bool) -> bool:
+        """Afloat or on the sand: the IMU's motion test when fresh, else the geometry.
+
+        Deep enough water (the estimated surface gives the displacement; with hysteresis: once
+        afloat, the hulls must sit clearly shallower to touch down) floats it. In the surf, the
+        IMU tells: on the sand the vehicle lies on the beach (no roll/pitch rate, no heave
+        acceleration); floating, it rolls, pitches and heaves with the waves. Both tracks
+        pushing hard (``tracks_pushing``) mean the sand.
+        """
+        displaced = self.vehicle.body.displaced_volume_m3
+        if pushing:
+            return False
+        limit = displaced * (TOUCHDOWN_SHARE if self.afloat else 1.0)
+        if grounded_volume_m3 >= limit:
+            # deep enough to float even in calm water - unless the IMU says the vehicle lies
+            # still on the sand, in a trough the estimated surface does not show
+            return not imu_fresh or self.motion_level > 1.0 \
+                or grounded_volume_m3 >= self.sure_float_m3
+        if imu_fresh:
+            return self.motion_level > 1.0 and \
+                grounded_volume_m3 >= self.settings.contact_min_volume_share * displaced
+        return False
+
+    def refresh(self, x: np.ndarray, imu_fresh: bool, pushing: bool) -> None:
+        """Decide afloat or on the sand and the weight share for the filter's state ``x``."""
+        _, grounded = self.submersion(x)
+        self.afloat = self.floating(grounded, imu_fresh, pushing)
+        self.fraction = self.fraction_of(self.weight_n(grounded, self.afloat))
+
+    def afloat_volume_m3(self, heave_accel_mps2: float, imu_fresh: bool) -> float:
+        """Floating: the displacement, plus what the heave acceleration says (IMU fresh)."""
+        body = self.vehicle.body
+        if not math.isfinite(heave_accel_mps2) or not imu_fresh:
+            return body.displaced_volume_m3
+        volume = buoyancy.afloat_dynamic_volume_m3(
+            body.displacement_n + self.heave_damping_n_per_mps * self.heave_velocity_mps,
+            self.heave_mass_kg, heave_accel_mps2, body.water_density_kgpm3, body.gravity_mps2)
+        return min(max(volume, 0.0), self.max_volume_m3)
+
+    def soil_force_n(self, x: np.ndarray, waterline_distance_m: float, surface_m: float,
+                     track_mps: float, ground_mps: float) -> float:
+        """Soil force on the vehicle from one track at these speeds, with the weight the
+        surface leaves it, N (heading from ``x``)."""
+        body = self.vehicle.body
+        heading_cos = math.cos(x[Idx.YAW] - self.settings.seaward_yaw_rad)
+        volume = buoyancy.grounded_volume_m3(waterline_distance_m, self.slope_rad,
+                                             body.hull_clearance_m, self.hull_bow_x_m,
+                                             self.hull_stern_x_m, body.hull_radius_m,
+                                             surface_m, heading_cos, self.section)
+        weight = traction.effective_weight_n(body.displacement_n,
+                                             min(volume, body.displaced_volume_m3),
+                                             self.slope_rad, body.water_density_kgpm3,
+                                             body.gravity_mps2)
+        return float(traction.track_force_n(track_mps, ground_mps, 0.5 * weight, self.soil,
+                                            self.track_area_m2, body.track_contact_length_m))

@@ -1,0 +1,275 @@
+"""The motion filter: the motion sensors' models around the EKF (``ekf.MotionEkf``), ROS-free.
+
+It keeps the latest motion inputs (IMU, track and propeller status), the sensors' last
+times, the GPS datum, and predicts the EKF forward: with the IMU's accelerations, else
+with the drive model (tracks when their share of the weight drives the vehicle, else the
+propellers). It corrects heading, yaw rate and gyro bias from the IMU, the position and
+velocity from the DGPS (antenna lever arm) and, GPS velocity stale on land, the speed
+from the tracks. The surface states' corrections live in ``surface.SurfaceObserver``.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from dukw_common.geometry import local_enu_from_geodetic, wrap_angle
+from dukw_common.vehicle import Vehicle
+from dukw_estimation.ekf import N_STATES, Idx, MotionEkf, Outcome, ProcessNoise
+from dukw_common.readings import DriveStatus, GpsFix, GpsVelocity, ImuSample
+from dukw_estimation.samples import OdometryEstimate
+from dukw_estimation.settings import SENSORS, EkfSettings
+
+MAX_PREDICT_STEP_S = 0.02
+GROUNDED_FRACTION = 0.5          # above this weight share the tracks drive the vehicle
+
+
+class MotionFilter:
+    """Pose, twist, gyro bias and GPS bias of base_link in odom (and the EKF's time)."""
+
+    def __init__(self, vehicle: Vehicle, settings: EkfSettings) -> None:
+        self.vehicle = vehicle
+        self.settings = settings
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to the initial covariance, no sample seen."""
+        st = self.settings
+        p0 = np.array([st.init_position_m ** 2, st.init_position_m ** 2, st.init_yaw_rad ** 2,
+                       st.init_velocity_mps ** 2, st.init_velocity_mps ** 2,
+                       st.init_yaw_rate_rps ** 2, st.init_gyro_bias_rps ** 2,
+                       st.waterline_sigma_m ** 2, st.wave_sigma_m ** 2 + 1e-6,
+                       (st.wave_sigma_m * 2 * math.pi * st.wave_peak_frequency_hz) ** 2 + 1e-6,
+                       st.gps_bias_sigma_m ** 2, st.gps_bias_sigma_m ** 2])
+        noise = ProcessNoise(st.q_position_m, st.q_yaw_rad, st.q_accel_mps2, st.q_yaw_accel_rps2,
+                             st.q_gyro_bias_rps, st.q_waterline_m,
+                             2 * math.pi * st.wave_peak_frequency_hz, st.wave_damping_ratio,
+                             st.wave_sigma_m, st.gps_bias_sigma_m, st.gps_bias_tau_s)
+        self.ekf = MotionEkf(np.zeros(N_STATES), p0, noise, st.seaward_yaw_rad)
+        self.t_s: float | None = None
+        self.last_t = {s: -math.inf for s in SENSORS}
+        self.datum: tuple[float, float, float] | None = None
+        if not st.datum_from_first_fix:
+            self.datum = (st.datum_latitude_deg, st.datum_longitude_deg, st.datum_altitude_m)
+        self.position_set = False
+        self.yaw_set = False
+        self.imu: ImuSample | None = None
+        self.accel_base = (math.nan, math.nan, math.nan)   # specific force at base_link
+        self.tracks: DriveStatus | None = None
+        self.props: DriveStatus | None = None
+
+    def fresh(self, sensor: str, t_s: float) -> bool:
+        """The sensor spoke within ``sensor_timeout_s`` before ``t_s``."""
+        return t_s - self.last_t[sensor] <= self.settings.sensor_timeout_s
+
+    def fresh_now(self, sensor: str) -> bool:
+        """The sensor is fresh at the filter's time (False before any sample)."""
+        return self.t_s is not None and self.fresh(sensor, self.t_s)
+
+    # ------------------------------------------------------------------ pose
+    def set_pose(self, x_m: float, y_m: float, yaw_rad: float) -> None:
+        """Reset the pose in odom; the waterline distance follows the new position."""
+        self.ekf.set_pose(x_m, y_m, yaw_rad, self.settings.init_position_m,
+                          self.settings.init_yaw_rad)
+        self._init_waterline()
+        self.position_set = self.yaw_set = True
+
+    def _init_waterline(self) -> None:
+        st = self.settings
+        x = self.ekf.x
+        seaward = ((x[Idx.X] - st.waterline_x_m) * math.cos(st.seaward_yaw_rad)
+                   + (x[Idx.Y] - st.waterline_y_m) * math.sin(st.seaward_yaw_rad))
+        inv_cos = 1.0 / math.cos(self.vehicle.site.beach_slope_rad)
+        x[Idx.S] = seaward * inv_cos
+        # s is the seaward position along the slope plus the waterline's survey error: it is
+        # correlated with x, y as they are, so the GPS's later corrections of the position
+        # (its drift averaged out) move s too
+        j = np.zeros(N_STATES)
+        j[Idx.X] = math.cos(st.seaward_yaw_rad) * inv_cos
+        j[Idx.Y] = math.sin(st.seaward_yaw_rad) * inv_cos
+        P = self.ekf.P
+        cross = P @ j
+        cross[Idx.S] = 0.0
+        P[Idx.S, :] = cross
+        P[:, Idx.S] = cross
+        P[Idx.S, Idx.S] = float(j @ cross) + st.waterline_sigma_m ** 2
+
+    # ------------------------------------------------------------------ time
+    def predict_to(self, t_s: float, fraction: float) -> None:
+        """Predict to ``t_s`` in steps of at most MAX_PREDICT_STEP_S (no-op when not newer);
+        ``fraction`` is the weight share on the tracks (for the drive model)."""
+        if self.t_s is None:
+            self.t_s = t_s
+            return
+        while t_s > self.t_s:
+            dt = min(MAX_PREDICT_STEP_S, t_s - self.t_s)
+            self._predict(dt, fraction)
+            self.t_s += dt
+
+    def _predict(self, dt: float, fraction: float) -> None:
+        x = self.ekf.x
+        st = self.settings
+        now = self.t_s + dt
+        imu = self.imu
+        accel = None
+        noise = None
+        target = None
+        if imu is not None and self.fresh('imu', now) and math.isfinite(self.accel_base[0]):
+            # gravity along the body axes from the attitude, scaled by the measured vertical
+            # specific force (heave accelerations afloat): g_up = f_z / (cos roll cos pitch)
+            fx, fy, fz = self.accel_base
+            tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
+            g_up = fz / max(tilt, 0.5)
+            accel = (fx + g_up * math.sin(imu.pitch_rad) + x[Idx.R] * x[Idx.V],
+                     fy - g_up * math.sin(imu.roll_rad) * math.cos(imu.pitch_rad)
+                     - x[Idx.R] * x[Idx.U])
+        else:
+            noise = st.q_accel_no_imu_mps2
+            target = self._drive_target(now, fraction)
+        self.ekf.predict(dt, accel, target, noise, self.vehicle.site.beach_slope_rad)
+
+    def _drive_target(self, now: float, fraction: float) -> tuple[float, float, float] | None:
+        st = self.settings
+        tau = st.drive_time_constant_s
+        if fraction > GROUNDED_FRACTION and self.tracks is not None \
+                and self.fresh('tracks', now):
+            vp, vs = self.tracks.port.speed_mps, self.tracks.stbd.speed_mps
+            return 0.5 * (vp + vs), (vs - vp) / st.effective_track_width_m, tau
+        if self.props is not None and self.fresh('props', now):
+            thrust = self.props.port.force_n + self.props.stbd.force_n
+            speed = math.copysign(math.sqrt(abs(thrust) / st.water_drag_n_per_mps2), thrust)
+            return speed, float(self.ekf.x[Idx.R]), tau
+        return None
+
+    # ------------------------------------------------------------------ IMU
+    def add_imu(self, s: ImuSample) -> tuple[Outcome, float]:
+        """Yaw rate and bias, heading; keeps the sample and its specific force at base_link.
+        Returns the outcome and the time since the previous IMU sample."""
+        dt = s.t_s - self.imu.t_s if self.imu is not None else 0.0
+        self.accel_base = self._accel_at_base_link(s, dt)
+        self.imu = s
+        st = self.settings
+        h = np.zeros(N_STATES)
+        h[Idx.R] = h[Idx.BIAS] = 1.0
+        var = s.yaw_rate_var_rps2 if s.yaw_rate_var_rps2 > 0 else st.gyro_rps ** 2
+        out = self.ekf.update_scalar(s.yaw_rate_rps, self.ekf.x[Idx.R] + self.ekf.x[Idx.BIAS],
+                                     h, var, st.gate_imu)
+        if math.isfinite(s.yaw_rad):
+            if not self.yaw_set:
+                self.ekf.x[Idx.YAW] = wrap_angle(s.yaw_rad)
+                self.yaw_set = True
+            h = np.zeros(N_STATES)
+            h[Idx.YAW] = 1.0
+            var = s.yaw_var_rad2 if s.yaw_var_rad2 > 0 else st.yaw_rad ** 2
+            yaw_out = self.ekf.update_scalar(s.yaw_rad, self.ekf.x[Idx.YAW], h, var,
+                                             st.gate_imu, angle=True)
+            if yaw_out is not Outcome.ACCEPTED:
+                out = yaw_out
+        return out, dt
+
+    def _accel_at_base_link(self, s: ImuSample, dt: float) -> tuple[float, float, float]:
+        """The specific force moved from the IMU (sensors.imu_z_m above base_link) to base_link.
+
+        A point at r = (0, 0, h) feels alpha x r + w x (w x r) more than base_link; alpha comes
+        from differencing the gyro (roll and pitch rates), which matters afloat.
+        """
+        h = self.vehicle.sensors.imu_z_m
+        prev = self.imu
+        if prev is not None and 0.0 < dt <= MAX_PREDICT_STEP_S * 5:
+            alpha_x = (s.roll_rate_rps - prev.roll_rate_rps) / dt
+            alpha_y = (s.pitch_rate_rps - prev.pitch_rate_rps) / dt
+        else:
+            alpha_x = alpha_y = 0.0
+        wx, wy, wz = s.roll_rate_rps, s.pitch_rate_rps, s.yaw_rate_rps
+        return (s.accel_x_mps2 - (alpha_y + wz * wx) * h,
+                s.accel_y_mps2 + (alpha_x - wz * wy) * h,
+                s.accel_z_mps2 + (wx * wx + wy * wy) * h)
+
+
+    def _lever_arm(self) -> tuple[float, float, float, float]:
+        """Antenna offset terms: (a, b, p, q) with a = h sin(pitch) cos(roll), b = h sin(roll)."""
+        h = self.vehicle.sensors.gps_antenna_z_m
+        imu = self.imu
+        if imu is None:
+            return 0.0, 0.0, 0.0, 0.0
+        return (h * math.sin(imu.pitch_rad) * math.cos(imu.roll_rad), h * math.sin(imu.roll_rad),
+                imu.roll_rate_rps, imu.pitch_rate_rps)
+
+
+    # ------------------------------------------------------------------ DGPS
+    def add_gps_fix(self, s: GpsFix) -> Outcome:
+        """DGPS position (geodetic) -> local ENU at the datum; corrects x, y."""
+        if self.datum is None:
+            self.datum = (s.latitude_deg, s.longitude_deg, s.altitude_m)
+        east, north, _ = local_enu_from_geodetic(s.latitude_deg, s.longitude_deg, s.altitude_m,
+                                                 *self.datum)
+        x = self.ekf.x
+        a, b, _, _ = self._lever_arm()
+        c, sn = math.cos(x[Idx.YAW]), math.sin(x[Idx.YAW])
+        offset = np.array([c * a + sn * b, sn * a - c * b])
+        var = s.horizontal_var_m2 if s.horizontal_var_m2 > 0 and self.settings.gps_bias_sigma_m \
+            == 0.0 else self.settings.gps_position_m ** 2
+        if not self.position_set:      # the first fix: start there, as sure as the fix is
+            x[Idx.X], x[Idx.Y] = east - offset[0], north - offset[1]
+            for i in (Idx.X, Idx.Y):
+                self.ekf.P[i, :] = 0.0
+                self.ekf.P[:, i] = 0.0
+                self.ekf.P[i, i] = var + self.settings.gps_bias_sigma_m ** 2
+            self._init_waterline()
+            self.position_set = True
+        H = np.zeros((2, N_STATES))
+        H[0, Idx.X] = H[1, Idx.Y] = H[0, Idx.GPS_BIAS_E] = H[1, Idx.GPS_BIAS_N] = 1.0
+        H[0, Idx.YAW] = -sn * a + c * b
+        H[1, Idx.YAW] = c * a + sn * b
+        # (with bias states the message's covariance, the total error, is not the white part)
+        predicted = x[[Idx.X, Idx.Y]] + offset + x[[Idx.GPS_BIAS_E, Idx.GPS_BIAS_N]]
+        return self.ekf.update(np.array([east, north]), predicted, H, np.eye(2) * var,
+                               self.settings.gate_gps_fix)
+
+    def add_gps_velocity(self, s: GpsVelocity) -> Outcome:
+        """DGPS ground velocity of the antenna (ENU); corrects u, v and yaw."""
+        x = self.ekf.x
+        h = self.vehicle.sensors.gps_antenna_z_m
+        _, _, p, q = self._lever_arm()
+        ub, vb = x[Idx.U] + q * h, x[Idx.V] - p * h
+        c, sn = math.cos(x[Idx.YAW]), math.sin(x[Idx.YAW])
+        H = np.zeros((2, N_STATES))
+        H[0, Idx.U], H[0, Idx.V], H[0, Idx.YAW] = c, -sn, -sn * ub - c * vb
+        H[1, Idx.U], H[1, Idx.V], H[1, Idx.YAW] = sn, c, c * ub - sn * vb
+        var = s.var_mps2 if s.var_mps2 > 0 else self.settings.gps_velocity_mps ** 2
+        return self.ekf.update(np.array([s.east_mps, s.north_mps]),
+                               np.array([c * ub - sn * vb, sn * ub + c * vb]), H,
+                               np.eye(2) * var, self.settings.gate_gps_vel)
+
+    # ------------------------------------------------------------------ tracks
+    def track_odometry(self, s: DriveStatus) -> None:
+        """GPS velocity stale on land: the tracks say roughly how fast we go."""
+        st = self.settings
+        H = np.zeros((2, N_STATES))
+        H[0, Idx.U] = H[1, Idx.R] = 1.0
+        z = np.array([0.5 * (s.port.speed_mps + s.stbd.speed_mps),
+                      (s.stbd.speed_mps - s.port.speed_mps) / st.effective_track_width_m])
+        var = st.track_odometry_mps ** 2
+        R = np.diag([var, var / st.effective_track_width_m ** 2])
+        self.ekf.update(z, self.ekf.x[[Idx.U, Idx.R]], H, R, math.inf)
+
+    # ------------------------------------------------------------------ output
+    def odometry(self, slope_rad: float) -> OdometryEstimate:
+        """Pose and twist of base_link in odom with covariances (z on the slope)."""
+        x, P = self.ekf.x, self.ekf.P
+        roll = self.imu.roll_rad if self.imu else 0.0
+        pitch = self.imu.pitch_rad if self.imu else 0.0
+        pose_cov = np.diag([0.0, 0.0, 1e3, 1e-2, 1e-2, 0.0])
+        ix = [Idx.X, Idx.Y]
+        pose_cov[np.ix_([0, 1], [0, 1])] = P[np.ix_(ix, ix)]
+        pose_cov[np.ix_([0, 1], [5])] = P[np.ix_(ix, [Idx.YAW])]
+        pose_cov[np.ix_([5], [0, 1])] = P[np.ix_([Idx.YAW], ix)]
+        pose_cov[5, 5] = P[Idx.YAW, Idx.YAW]
+        twist_cov = np.diag([0.0, 0.0, 1e3, 1e3, 1e3, 0.0])
+        it = [Idx.U, Idx.V]
+        twist_cov[np.ix_([0, 1], [0, 1])] = P[np.ix_(it, it)]
+        twist_cov[5, 5] = P[Idx.R, Idx.R]
+        z = -x[Idx.S] * math.sin(slope_rad)
+        return OdometryEstimate(self.t_s or 0.0, float(x[Idx.X]), float(x[Idx.Y]), z, roll,
+                                pitch, float(x[Idx.YAW]), float(x[Idx.U]), float(x[Idx.V]),
+                                float(x[Idx.R]), pose_cov, twist_cov)

@@ -1,0 +1,168 @@
+"""Where the water surface is: corrections of the filter's surface states, ROS-free.
+
+The waterline distance s and the wave elevation eta (``ekf.SURFACE_STATES``) are measured
+by the wet/dry sensors, the depth sounder and, on the sand, the track forces (through the
+weight the surface leaves on the tracks, ``contact.ContactModel``). Each update here
+touches only the surface states of the shared ``MotionEkf``.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from dukw_common.vehicle import Vehicle
+from dukw_estimation import traction
+from dukw_estimation.contact import ContactModel, ground_speeds
+from dukw_estimation.ekf import N_STATES, SURFACE_STATES, WATERLINE_STATE, Idx, MotionEkf, Outcome
+from dukw_common.readings import DepthReading, DriveStatus, WaterContact
+from dukw_estimation.settings import EkfSettings
+
+SECANT_STEPS_M = (0.005, 0.02, 0.05, 0.1, 0.2)   # surface steps of the force's derivative
+GROUND_STEP_MPS = 0.01                            # ground-speed step of the force's derivative
+
+
+class SurfaceObserver:
+    """The surface measurements: water contact, depth soundings, track forces."""
+
+    def __init__(self, vehicle: Vehicle, settings: EkfSettings, contact: ContactModel) -> None:
+        self.vehicle = vehicle
+        self.settings = settings
+        self.contact = contact
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget when the tracks touched down and when their forces were last used."""
+        self.grounded_since_s = math.inf
+        self.force_update_t_s = -math.inf
+
+    # ------------------------------------------------------------------ wet / dry
+    def water_contact(self, ekf: MotionEkf, s: WaterContact) -> Outcome:
+        """Wet/dry sensors: where the state disagrees, the surface is at the sensor."""
+        if self.contact.afloat:
+            # floating, the sensors ride with the hull, not at a height above the sand
+            return Outcome.ACCEPTED
+        mounts = self.vehicle.sensors
+        out = Outcome.IGNORED
+        for wet, x_m, z_m in ((s.fore_wet, mounts.fore_water_x_m, mounts.fore_water_z_m),
+                              (s.aft_wet, mounts.aft_water_x_m, mounts.aft_water_z_m)):
+            depth, h = self._sensor_depth(ekf.x, x_m, z_m)
+            if bool(wet) == (depth > 0.0):
+                continue
+            result = ekf.update_scalar(0.0, depth, h, self.settings.contact_m ** 2,
+                                       self.settings.gate_water, only=SURFACE_STATES)
+            if out is not Outcome.REJECTED_OUTLIER:
+                out = result
+        if out is Outcome.IGNORED:
+            out = Outcome.ACCEPTED    # consistent with the state: nothing to correct
+        return out
+
+    def _sensor_depth(self, x: np.ndarray, x_m: float, z_m: float) -> tuple[float, np.ndarray]:
+        """Water over a sensor at body (x, z) of a vehicle on the slope, and its Jacobian."""
+        slope = self.contact.slope_rad
+        sin_t, cos_t = math.sin(slope), math.cos(slope)
+        rel = x[Idx.YAW] - self.settings.seaward_yaw_rad
+        depth = x[Idx.ETA] + (x[Idx.S] + x_m * math.cos(rel)) * sin_t - z_m * cos_t
+        h = np.zeros(N_STATES)
+        h[Idx.ETA] = 1.0
+        h[Idx.S] = sin_t
+        h[Idx.YAW] = -x_m * math.sin(rel) * sin_t
+        return depth, h
+
+    # ------------------------------------------------------------------ sounder
+    def depth(self, ekf: MotionEkf, s: DepthReading) -> Outcome:
+        """A valid sounding means the transducer floats above the sea bed: corrects s, eta."""
+        x = ekf.x
+        body, mounts, site = self.vehicle.body, self.vehicle.sensors, self.vehicle.site
+        sin_t = math.sin(self.contact.slope_rad)
+        floor_depth = x[Idx.S] * sin_t
+        h = np.zeros(N_STATES)
+        h[Idx.ETA] = 1.0
+        if floor_depth < site.sea_floor_depth_m:
+            h[Idx.S] = sin_t
+        floor_depth = min(floor_depth, site.sea_floor_depth_m)
+        predicted = x[Idx.ETA] - body.draft_m + mounts.depth_sounder_z_m + floor_depth
+        return ekf.update_scalar(s.depth_m, predicted, h, self.settings.depth_m ** 2,
+                                 self.settings.gate_depth, only=WATERLINE_STATE)
+
+    # ------------------------------------------------------------------ track forces
+    def track_forces(self, ekf: MotionEkf, s: DriveStatus) -> None:
+        """The smoothed track forces against the Wong force of the estimated weight: a
+        measurement of the surface (vehicle.md 6), where both tracks turn and slip enough for
+        the force to depend on the weight (a stopped or gripping track takes whatever force
+        holds it), ``force_update.settle_s`` after a touchdown, and the surface can change
+        the force (``_force_per_m``). The ground speed's uncertainty joins the force noise
+        through the slip."""
+        if self.contact.afloat:
+            self.grounded_since_s = math.inf
+            return
+        self.grounded_since_s = min(self.grounded_since_s, s.t_s)
+        if not self._force_update_due(s.t_s):
+            return
+        speeds = (s.port.speed_mps, s.stbd.speed_mps)
+        ground = ground_speeds(ekf.x, self.vehicle.body.hull_separation_m)
+        if not self._slipping(speeds, ground):
+            return
+        measured = [self.contact.measured_soil_force_n(s, k) for k in range(2)]
+        if not all(math.isfinite(m) for m in measured):
+            return
+        self.force_update_t_s = s.t_s
+        for k in range(2):
+            self._track_force_update(ekf, k, measured[k], speeds[k], ground[k])
+
+    def _force_update_due(self, t_s: float) -> bool:
+        st = self.settings
+        return not (st.force_update_sigma_n <= 0.0
+                    or t_s - self.grounded_since_s < st.force_update_settle_s
+                    or t_s - self.force_update_t_s < st.force_update_period_s)
+
+    def _slipping(self, speeds: tuple[float, float], ground: tuple[float, float]) -> bool:
+        """Both tracks turn fast enough and slip enough for the force to tell the weight."""
+        st = self.settings
+        slips = [float(traction.slip(speeds[k], ground[k])) for k in range(2)]
+        return all(abs(speeds[k]) >= st.force_update_min_track_speed_mps
+                   and abs(slips[k]) >= st.force_update_min_slip for k in range(2))
+
+    def _track_force_update(self, ekf: MotionEkf, k: int, measured_n: float, track_mps: float,
+                            ground_mps: float) -> None:
+        """One track's (0 port, 1 starboard) soil force as a measurement of s and eta."""
+        st = self.settings
+        x, P = ekf.x, ekf.P
+        sin_t = math.sin(self.contact.slope_rad)
+        half = 0.5 * self.vehicle.body.hull_separation_m
+        lever = -half if k == 0 else half
+        force = self.contact.soil_force_n
+        predicted = force(x, x[Idx.S], x[Idx.ETA], track_mps, ground_mps)
+        per_m = self._force_per_m(x, predicted, measured_n, track_mps, ground_mps)
+        if per_m is None:
+            return                       # the surface cannot explain the difference
+        per_mps = (force(x, x[Idx.S], x[Idx.ETA], track_mps, ground_mps + GROUND_STEP_MPS)
+                   - predicted) / GROUND_STEP_MPS
+        ground_var = P[Idx.U, Idx.U] + lever * lever * P[Idx.R, Idx.R] \
+            + 2.0 * lever * P[Idx.U, Idx.R]
+        h = np.zeros(N_STATES)
+        h[Idx.ETA] = per_m
+        h[Idx.S] = per_m * sin_t         # the volume follows the water depth eta + s sin
+        var = st.force_update_sigma_n ** 2 + per_mps * per_mps * max(ground_var, 0.0)
+        ekf.update_scalar(measured_n, predicted, h, var, st.force_update_gate,
+                          only=SURFACE_STATES)
+
+    def _force_per_m(self, x: np.ndarray, predicted_n: float, measured_n: float,
+                     track_mps: float, ground_mps: float) -> float | None:
+        """d force / d surface, N/m; None where the surface cannot change the force.
+
+        Where the estimate puts no weight on the tracks (the volume capped at the
+        displacement) the local derivative is nil, and a track clearly pushing under a hull
+        thought afloat would be ignored: when the force asks for less water, the secant over
+        the first of growing steps down that changes the force is used instead. On dry
+        sand (all the weight on the tracks) a force short of the model's says more about the
+        soil than about water, and only the local derivative counts.
+        """
+        less_water = measured_n > predicted_n
+        steps, direction = (SECANT_STEPS_M, -1.0) if less_water else (SECANT_STEPS_M[:1], 1.0)
+        for step_m in steps:
+            moved = self.contact.soil_force_n(x, x[Idx.S], x[Idx.ETA] + direction * step_m,
+                                              track_mps, ground_mps)
+            if abs(moved - predicted_n) > 1e-3:
+                return (moved - predicted_n) / (direction * step_m)
+        return None
