@@ -140,18 +140,61 @@ def regular_waves(height_m: float, period_s: float, reference_depth_m: float,
                           np.array([k * math.sin(direction_rad)]), np.array([0.0]))
 
 
+def cos2s_density(offset_rad: np.ndarray, exponent_s: float) -> np.ndarray:
+    """Directional spreading D(theta - theta_mean) = G(s) cos^2s((theta - theta_mean) / 2), 1/rad.
+
+    The cos-2s function of Longuet-Higgins et al. (1963), with Mitsuyasu et al.'s (1975)
+    parameter s; G(s) = 2^(2s-1) Gamma(s+1)^2 / (pi Gamma(2s+1)) makes it integrate to 1 over
+    [-pi, pi]. Its first circular moment is s / (s + 1).
+    """
+    if exponent_s <= 0.0:
+        raise ValueError(f'the cos-2s spreading exponent must be > 0, got {exponent_s}')
+    log_g = ((2.0 * exponent_s - 1.0) * math.log(2.0) + 2.0 * math.lgamma(exponent_s + 1.0)
+             - math.log(math.pi) - math.lgamma(2.0 * exponent_s + 1.0))
+    half = np.abs(np.cos(0.5 * np.asarray(offset_rad, dtype=float)))
+    return math.exp(log_g) * half ** (2.0 * exponent_s)
+
+
+def spreading_offsets_rad(exponent_s: float, directions: int) -> np.ndarray:
+    """Directions of ``directions`` equal-energy bins of the cos-2s spreading, about the mean.
+
+    Each is the median of its bin (the quantile (j + 1/2) / J of D), so every direction
+    carries the same share of the energy and the set follows D's shape.
+    """
+    if directions < 1:
+        raise ValueError('directional spreading needs at least one direction')
+    grid = np.linspace(-math.pi, math.pi, 4001)
+    density = cos2s_density(grid, exponent_s)
+    cdf = np.concatenate([[0.0], np.cumsum(0.5 * (density[1:] + density[:-1]) * np.diff(grid))])
+    cdf /= cdf[-1]
+    return np.interp((np.arange(directions) + 0.5) / directions, cdf, grid)
+
+
 def irregular_waves(significant_height_m: float, peak_period_s: float, reference_depth_m: float,
                     rng: np.random.Generator, count: int = 32, gamma: float = 3.3,
-                    spreading_rad: float = 0.0,
-                    direction_rad: float = math.pi) -> WaveComponents:
+                    spreading_rad: float = 0.0, direction_rad: float = math.pi,
+                    spreading_exponent_s: float = 0.0, directions: int = 1) -> WaveComponents:
     """A JONSWAP sea as ``count`` components with random frequencies, phases and directions.
 
     Frequencies are drawn uniformly inside equal bins over [0.5, 3] f_peak (no
     repetition period); amplitudes a = sqrt(2 S(f) df), rescaled so that the
     components' 4 sqrt(m0) equals Hs exactly.
+
+    Directions: with ``spreading_exponent_s`` = 0, each component's heading is drawn
+    uniformly within +- ``spreading_rad`` of ``direction_rad`` (0: long-crested). With
+    s > 0 the sea is short-crested with the cos-2s spreading (``cos2s_density``): the
+    spectrum is split into ``directions`` equal-energy direction bins and each run of
+    ``directions`` consecutive frequency bins takes them all in random order (a single
+    summation: every component keeps its own frequency, so the field stays ergodic and
+    the cost stays ``count`` components).
     """
     if count < 1:
         raise ValueError('an irregular sea needs at least one component')
+    if spreading_exponent_s < 0.0 or directions < 1:
+        raise ValueError('spreading_exponent_s must be >= 0 and directions >= 1')
+    if spreading_exponent_s > 0.0 and spreading_rad != 0.0:
+        raise ValueError('give either the uniform spreading_rad or the cos-2s '
+                         'spreading_exponent_s, not both')
     fp = 1.0 / peak_period_s
     edges = np.linspace(0.5 * fp, 3.0 * fp, count + 1)
     df = np.diff(edges)
@@ -165,7 +208,13 @@ def irregular_waves(significant_height_m: float, peak_period_s: float, reference
         amplitude *= significant_height_m / (4.0 * math.sqrt(m0))
     omega = 2.0 * math.pi * freq
     k = np.array([wavenumber(w, reference_depth_m) for w in omega])
-    heading = direction_rad + spreading_rad * rng.uniform(-1.0, 1.0, count)
+    if spreading_exponent_s > 0.0:
+        offsets = spreading_offsets_rad(spreading_exponent_s, directions)
+        runs = -(-count // directions)
+        order = np.concatenate([rng.permutation(directions) for _ in range(runs)])[:count]
+        heading = direction_rad + offsets[order]
+    else:
+        heading = direction_rad + spreading_rad * rng.uniform(-1.0, 1.0, count)
     phase = rng.uniform(0.0, 2.0 * math.pi, count)
     return WaveComponents(amplitude, omega, k * np.cos(heading), k * np.sin(heading), phase)
 
