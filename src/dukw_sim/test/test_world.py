@@ -116,7 +116,8 @@ def _reference_sample(world: World, x, y, t, kin_height_m):
     depth = max(float(still.mean()), 0.05)
     zc = min(max(kin_height_m, -depth), 0.0)
     eta, vel, acc = np.zeros(x.size), np.zeros((x.size, 2)), np.zeros((x.size, 2))
-    for a, om, kx, ky, ph in zip(w.amplitude_m, w.omega_rps, w.kx, w.ky, w.phase_rad):
+    for a, om, kx, ky, ph in zip(w.amplitude_m, w.omega_rps, w.kx, w.ky, w.phase_rad,
+                                 strict=True):
         k = math.hypot(kx, ky)
         theta = kx * x + ky * y + ph - om * t
         eta += a * np.cos(theta)
