@@ -279,6 +279,7 @@ class World:
         self._wavenumbers[0], self._wavenumbers[1] = waves.kx, waves.ky
         self._wavenumbers[3] = -0.5 * math.pi
         self._time_key: float | None = None
+        self._transfer_key: tuple[float, float] | None = None
         self._points = np.zeros((0, 4))
         self._points_key = (0, 0)
         self._still_x = np.array([beach.flat_start_x_m, beach.sea_floor_x_m])
@@ -345,6 +346,9 @@ class World:
             x, y = x.ravel(), y.ravel()
         n = x.size
         kin_points = max(min(kin_points, n), 0)
+        if n and x.max() <= 0.0:                  # all on the sand: breaking leaves no wave
+            kin = np.zeros(kin_points)
+            return WaterSample(np.zeros(shape), kin, kin, kin, kin)
         rows = self._point_rows(x, y, kin_points)
         trig = np.cos(rows @ self._phase_matrix(t_s))   # cos on the first n rows, then sin
         factor = np.interp(rows[:, 0], self._cap_x, self._cap)
@@ -366,9 +370,12 @@ class World:
         depth = float(np.interp(x_kin, self._still_x, self._still_depth).sum()) / x_kin.size
         depth = max(depth, _MIN_KINEMATIC_DEPTH_M)
         zc = min(max(kin_height_m, -depth), 0.0)
+        if (zc, depth) == self._transfer_key:     # e.g. the hull above the water
+            return
         transfer = np.cosh(self._k * (zc + depth))
         transfer /= np.sinh(self._k * depth)
         np.multiply(transfer[:, None], self._kin_weights, out=self._weights[:, 1:])
+        self._transfer_key = (zc, depth)
 
     def elevation_m(self, x_m: float, y_m: float, t_s: float) -> float:
         """Water surface above mean level at one point, m."""
