@@ -28,8 +28,11 @@ def main() -> None:
     """Run every scenario for --seconds of simulated time and print the figures."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--seconds', type=float, default=60.0, help='simulated time per case')
+    parser.add_argument('--only', default='', help='run the scenarios whose name has this')
     args = parser.parse_args()
     for name, overrides, reset, act in SCENARIOS:
+        if args.only not in name:
+            continue
         sim = SimCore.from_config(overrides=overrides, seed=1)
         sim.reset(**reset)
         steps = int(args.seconds / sim.dt_s)

@@ -50,6 +50,9 @@ class WaveParams:
     jonswap_gamma: float
     components: int
     spreading_rad: float
+    mean_direction_rad: float
+    spreading_exponent_s: float
+    directions: int
     reference_depth_m: float
     breaking_ratio: float
     surge_inertia_coeff: float
@@ -63,6 +66,19 @@ class WaveParams:
         _positive(self, 'peak_period_s', 'jonswap_gamma', 'reference_depth_m', 'breaking_ratio')
         if self.components < 1:
             raise ConfigError('waves.components must be >= 1')
+        self._check_spreading()
+
+    def _check_spreading(self) -> None:
+        if self.spreading_exponent_s < 0.0 or self.directions < 1:
+            raise ConfigError('waves.spreading_exponent_s must be >= 0 and '
+                              'waves.directions >= 1')
+        if self.spreading_exponent_s == 0.0 and self.directions != 1:
+            raise ConfigError('waves.directions > 1 needs the cos-2s spreading '
+                              '(waves.spreading_exponent_s > 0)')
+        if self.spreading_exponent_s > 0.0 and (self.spreading_rad != 0.0
+                                                or self.directions < 2):
+            raise ConfigError('the cos-2s spreading (waves.spreading_exponent_s > 0) needs '
+                              'waves.spreading_rad = 0 and waves.directions >= 2')
 
 
 @dataclass(frozen=True)

@@ -140,18 +140,61 @@ def regular_waves(height_m: float, period_s: float, reference_depth_m: float,
                           np.array([k * math.sin(direction_rad)]), np.array([0.0]))
 
 
+def cos2s_density(offset_rad: np.ndarray, exponent_s: float) -> np.ndarray:
+    """Directional spreading D(theta - theta_mean) = G(s) cos^2s((theta - theta_mean) / 2), 1/rad.
+
+    The cos-2s function of Longuet-Higgins et al. (1963), with Mitsuyasu et al.'s (1975)
+    parameter s; G(s) = 2^(2s-1) Gamma(s+1)^2 / (pi Gamma(2s+1)) makes it integrate to 1 over
+    [-pi, pi]. Its first circular moment is s / (s + 1).
+    """
+    if exponent_s <= 0.0:
+        raise ValueError(f'the cos-2s spreading exponent must be > 0, got {exponent_s}')
+    log_g = ((2.0 * exponent_s - 1.0) * math.log(2.0) + 2.0 * math.lgamma(exponent_s + 1.0)
+             - math.log(math.pi) - math.lgamma(2.0 * exponent_s + 1.0))
+    half = np.abs(np.cos(0.5 * np.asarray(offset_rad, dtype=float)))
+    return math.exp(log_g) * half ** (2.0 * exponent_s)
+
+
+def spreading_offsets_rad(exponent_s: float, directions: int) -> np.ndarray:
+    """Directions of ``directions`` equal-energy bins of the cos-2s spreading, about the mean.
+
+    Each is the median of its bin (the quantile (j + 1/2) / J of D), so every direction
+    carries the same share of the energy and the set follows D's shape.
+    """
+    if directions < 1:
+        raise ValueError('directional spreading needs at least one direction')
+    grid = np.linspace(-math.pi, math.pi, 4001)
+    density = cos2s_density(grid, exponent_s)
+    cdf = np.concatenate([[0.0], np.cumsum(0.5 * (density[1:] + density[:-1]) * np.diff(grid))])
+    cdf /= cdf[-1]
+    return np.interp((np.arange(directions) + 0.5) / directions, cdf, grid)
+
+
 def irregular_waves(significant_height_m: float, peak_period_s: float, reference_depth_m: float,
                     rng: np.random.Generator, count: int = 32, gamma: float = 3.3,
-                    spreading_rad: float = 0.0,
-                    direction_rad: float = math.pi) -> WaveComponents:
+                    spreading_rad: float = 0.0, direction_rad: float = math.pi,
+                    spreading_exponent_s: float = 0.0, directions: int = 1) -> WaveComponents:
     """A JONSWAP sea as ``count`` components with random frequencies, phases and directions.
 
     Frequencies are drawn uniformly inside equal bins over [0.5, 3] f_peak (no
     repetition period); amplitudes a = sqrt(2 S(f) df), rescaled so that the
     components' 4 sqrt(m0) equals Hs exactly.
+
+    Directions: with ``spreading_exponent_s`` = 0, each component's heading is drawn
+    uniformly within +- ``spreading_rad`` of ``direction_rad`` (0: long-crested). With
+    s > 0 the sea is short-crested with the cos-2s spreading (``cos2s_density``): the
+    spectrum is split into ``directions`` equal-energy direction bins and each run of
+    ``directions`` consecutive frequency bins takes them all in random order (a single
+    summation: every component keeps its own frequency, so the field stays ergodic and
+    the cost stays ``count`` components).
     """
     if count < 1:
         raise ValueError('an irregular sea needs at least one component')
+    if spreading_exponent_s < 0.0 or directions < 1:
+        raise ValueError('spreading_exponent_s must be >= 0 and directions >= 1')
+    if spreading_exponent_s > 0.0 and spreading_rad != 0.0:
+        raise ValueError('give either the uniform spreading_rad or the cos-2s '
+                         'spreading_exponent_s, not both')
     fp = 1.0 / peak_period_s
     edges = np.linspace(0.5 * fp, 3.0 * fp, count + 1)
     df = np.diff(edges)
@@ -165,7 +208,13 @@ def irregular_waves(significant_height_m: float, peak_period_s: float, reference
         amplitude *= significant_height_m / (4.0 * math.sqrt(m0))
     omega = 2.0 * math.pi * freq
     k = np.array([wavenumber(w, reference_depth_m) for w in omega])
-    heading = direction_rad + spreading_rad * rng.uniform(-1.0, 1.0, count)
+    if spreading_exponent_s > 0.0:
+        offsets = spreading_offsets_rad(spreading_exponent_s, directions)
+        runs = -(-count // directions)
+        order = np.concatenate([rng.permutation(directions) for _ in range(runs)])[:count]
+        heading = direction_rad + offsets[order]
+    else:
+        heading = direction_rad + spreading_rad * rng.uniform(-1.0, 1.0, count)
     phase = rng.uniform(0.0, 2.0 * math.pi, count)
     return WaveComponents(amplitude, omega, k * np.cos(heading), k * np.sin(heading), phase)
 
@@ -192,7 +241,17 @@ class WaterSample:
 
 
 class World:
-    """Beach plus waves: ground height, water surface, depth and kinematics anywhere."""
+    """Beach plus waves: ground height, water surface, depth and kinematics anywhere.
+
+    ``sample`` is the simulator's hot path (once per physics step, 20+ points), so it is
+    a handful of numpy operations over points x components, whatever their number: the
+    phases of all points come from one matrix product with the components' wavenumbers
+    (whose time row is refreshed once per instant), one cosine gives the elevations and,
+    on extra rows shifted by a quarter period, the sines the accelerations need, and one
+    more product with the amplitude and depth-transfer weights gives elevation, velocity
+    and acceleration together. The breaking cap and the still depth are piecewise linear
+    in x, one interpolation each.
+    """
 
     def __init__(self, beach: Beach, waves: WaveComponents, breaking_ratio: float = 0.78,
                  reference_depth_m: float = 0.76) -> None:
@@ -204,22 +263,67 @@ class World:
         self.reference_depth_m = reference_depth_m
         self._height_scale = waves.height_scale_m if waves.count else 0.0
         self._cap_per_m = breaking_ratio / self._height_scale if self._height_scale else 0.0
+        self._calm = waves.count == 0 or self._height_scale == 0.0
         self._k = np.hypot(waves.kx, waves.ky)
-        self._a_omega = waves.amplitude_m * waves.omega_rps
         safe_k = np.where(self._k > 0.0, self._k, 1.0)
-        # unit travel direction of each component, as an (M, 2) matrix for one matmul
-        self._dirs = np.column_stack([waves.kx / safe_k, waves.ky / safe_k])
+        dirs = np.column_stack([waves.kx / safe_k, waves.ky / safe_k])
+        a_omega = waves.amplitude_m * waves.omega_rps
+        # velocity (a w dir) and acceleration (a w^2 dir) weights before the depth transfer
+        self._kin_weights = np.column_stack([a_omega[:, None] * dirs,
+                                             (a_omega * waves.omega_rps)[:, None] * dirs])
+        # the result weights: amplitude, then the kinematic ones times the depth transfer
+        self._weights = np.zeros((waves.count, 5))
+        self._weights[:, 0] = waves.amplitude_m
+        # phase = [x, y, 1, quarter] @ [kx; ky; phase - omega t; -pi/2]
+        self._wavenumbers = np.zeros((4, waves.count))
+        self._wavenumbers[0], self._wavenumbers[1] = waves.kx, waves.ky
+        self._wavenumbers[3] = -0.5 * math.pi
+        self._time_key: float | None = None
+        self._transfer_key: tuple[float, float] | None = None
+        self._points = np.zeros((0, 4))
+        self._points_key = (0, 0)
+        self._still_x = np.array([beach.flat_start_x_m, beach.sea_floor_x_m])
+        self._still_depth = -beach.heights_m(self._still_x)
+        # breaking cap: 0 at the waterline, growing with the depth up to 1 (or the sea floor)
+        tan = math.tan(beach.slope_rad)
+        full_x = beach.sea_floor_x_m
+        if self._cap_per_m > 0.0:
+            full_x = min(full_x, 1.0 / (self._cap_per_m * tan))
+        self._cap_x = np.array([0.0, full_x])
+        self._cap = np.array([0.0, min(full_x * tan * self._cap_per_m, 1.0)])
 
     @property
     def calm(self) -> bool:
         """True when there are no waves."""
-        return self.waves.count == 0 or self._height_scale == 0.0
+        return self._calm
 
     def breaking_factor(self, still_depth_m: np.ndarray) -> np.ndarray:
         """Wave-height factor in [0, 1]: H <= breaking_ratio * local still-water depth."""
-        if self.calm:
+        if self._calm:
             return np.zeros_like(still_depth_m)
         return np.minimum(np.maximum(still_depth_m, 0.0) * self._cap_per_m, 1.0)
+
+    def _phase_matrix(self, t_s: float) -> np.ndarray:
+        """The (4, M) matrix of ``_wavenumbers`` with its time row set for t (once per t)."""
+        if t_s != self._time_key:
+            np.subtract(self.waves.phase_rad, self.waves.omega_rps * t_s,
+                        out=self._wavenumbers[2])
+            self._time_key = t_s
+        return self._wavenumbers
+
+    def _point_rows(self, x: np.ndarray, y: np.ndarray, kin_points: int) -> np.ndarray:
+        """Rows [x, y, 1, 0] of every point, then [x, y, 1, 1] of the kinematic ones."""
+        n = x.size
+        rows = self._points
+        if self._points_key != (n, kin_points):
+            rows = np.zeros((n + kin_points, 4))
+            rows[:, 2] = 1.0
+            rows[n:, 3] = 1.0
+            self._points, self._points_key = rows, (n, kin_points)
+        rows[:n, 0] = x
+        rows[:n, 1] = y
+        rows[n:, :2] = rows[:kin_points, :2]
+        return rows
 
     def sample(self, x_m: np.ndarray, y_m: np.ndarray, t_s: float, kin_points: int = 0,
                kin_height_m: float = 0.0) -> WaterSample:
@@ -230,28 +334,48 @@ class World:
         few metres long on a gentle slope): the depth transfer is computed once per call.
         """
         x = np.asarray(x_m, dtype=float)
-        if self.calm:
+        if self._calm:
             zero = np.zeros_like(x)
             kin = np.zeros(kin_points)
             return WaterSample(zero, kin, kin, kin, kin)
-        w = self.waves
-        still = -self.beach.heights_m(x)
-        factor = self.breaking_factor(still)
-        phase = (np.multiply.outer(x, w.kx) + np.multiply.outer(np.asarray(y_m, float), w.ky)
-                 + (w.phase_rad - w.omega_rps * t_s))
-        cos_p = np.cos(phase)
-        eta = factor * (cos_p @ w.amplitude_m)
-        if kin_points <= 0:
+        y = np.asarray(y_m, dtype=float)
+        shape = x.shape
+        if x.ndim != 1 or y.shape != shape:       # grids, scalars: flat points
+            x, y = np.broadcast_arrays(x, y)
+            shape = x.shape
+            x, y = x.ravel(), y.ravel()
+        n = x.size
+        kin_points = max(min(kin_points, n), 0)
+        if n and x.max() <= 0.0:                  # all on the sand: breaking leaves no wave
+            kin = np.zeros(kin_points)
+            return WaterSample(np.zeros(shape), kin, kin, kin, kin)
+        rows = self._point_rows(x, y, kin_points)
+        trig = np.cos(rows @ self._phase_matrix(t_s))   # cos on the first n rows, then sin
+        factor = np.interp(rows[:, 0], self._cap_x, self._cap)
+        if kin_points:
+            self._set_transfer(x[:kin_points], kin_height_m)
+            out = trig @ self._weights
+        else:
+            out = trig @ self._weights[:, :1]
+        out *= factor[:, None]
+        eta = out[:n, 0].reshape(shape)
+        if not kin_points:
             kin = np.zeros(0)
             return WaterSample(eta, kin, kin, kin, kin)
-        depth = max(float(still[:kin_points].sum()) / kin_points, _MIN_KINEMATIC_DEPTH_M)
+        return WaterSample(eta, out[:kin_points, 1], out[:kin_points, 2], out[n:, 3],
+                           out[n:, 4])
+
+    def _set_transfer(self, x_kin: np.ndarray, kin_height_m: float) -> None:
+        """Kinematic weights times cosh k(z + d) / sinh k d at the points' mean still depth."""
+        depth = float(np.interp(x_kin, self._still_x, self._still_depth).sum()) / x_kin.size
+        depth = max(depth, _MIN_KINEMATIC_DEPTH_M)
         zc = min(max(kin_height_m, -depth), 0.0)
-        transfer = np.cosh(self._k * (zc + depth)) / np.sinh(self._k * depth)
-        speed = transfer * self._a_omega
-        f = factor[:kin_points, None]
-        vel = f * (cos_p[:kin_points] @ (speed[:, None] * self._dirs))
-        acc = f * (np.sin(phase[:kin_points]) @ ((speed * w.omega_rps)[:, None] * self._dirs))
-        return WaterSample(eta, vel[:, 0], vel[:, 1], acc[:, 0], acc[:, 1])
+        if (zc, depth) == self._transfer_key:     # e.g. the hull above the water
+            return
+        transfer = np.cosh(self._k * (zc + depth))
+        transfer /= np.sinh(self._k * depth)
+        np.multiply(transfer[:, None], self._kin_weights, out=self._weights[:, 1:])
+        self._transfer_key = (zc, depth)
 
     def elevation_m(self, x_m: float, y_m: float, t_s: float) -> float:
         """Water surface above mean level at one point, m."""

@@ -4,8 +4,10 @@ import math
 import numpy as np
 import pytest
 
-from dukw_sim.world import (Beach, World, irregular_waves, jonswap_density, no_waves,
-                            regular_waves, wavenumber)
+from dukw_common.config import ConfigError
+from dukw_sim.core import SimCore
+from dukw_sim.world import (Beach, World, cos2s_density, irregular_waves, jonswap_density,
+                            no_waves, regular_waves, spreading_offsets_rad, wavenumber)
 
 SLOPE = math.radians(4.5)
 
@@ -104,3 +106,118 @@ def test_calm_water_is_flat():
     s = world.sample(np.array([5.0, 10.0]), np.zeros(2), 3.0, kin_points=2)
     assert not np.any(s.elevation_m) and not np.any(s.accel_x_mps2)
     assert world.water_depth_m(10.0, 0.0, 1.0) == pytest.approx(10.0 * math.tan(SLOPE))
+
+
+def _reference_sample(world: World, x, y, t, kin_height_m):
+    """The linear wave field summed component by component (the textbook formulas)."""
+    w, beach = world.waves, world.beach
+    still = -beach.heights_m(x)
+    factor = np.minimum(np.maximum(still, 0.0) * world.breaking_ratio / w.height_scale_m, 1.0)
+    depth = max(float(still.mean()), 0.05)
+    zc = min(max(kin_height_m, -depth), 0.0)
+    eta, vel, acc = np.zeros(x.size), np.zeros((x.size, 2)), np.zeros((x.size, 2))
+    for a, om, kx, ky, ph in zip(w.amplitude_m, w.omega_rps, w.kx, w.ky, w.phase_rad,
+                                 strict=True):
+        k = math.hypot(kx, ky)
+        theta = kx * x + ky * y + ph - om * t
+        eta += a * np.cos(theta)
+        speed = a * om * math.cosh(k * (zc + depth)) / math.sinh(k * depth)
+        vel += np.outer(speed * np.cos(theta), [kx / k, ky / k])
+        acc += np.outer(speed * om * np.sin(theta), [kx / k, ky / k])
+    return factor * eta, factor[:, None] * vel, factor[:, None] * acc
+
+
+@pytest.mark.parametrize('spread', [{}, {'spreading_exponent_s': 10.0, 'directions': 6}])
+def test_vectorised_sample_matches_the_component_sum(spread):
+    rng = np.random.default_rng(3)
+    world = World(beach(), irregular_waves(0.28, 3.6, 0.76, rng, count=24, **spread))
+    x, y = rng.uniform(-3.0, 25.0, 12), rng.uniform(-2.0, 2.0, 12)
+    for t in (0.0, 7.31, 250.0):
+        s = world.sample(x, y, t, kin_points=12, kin_height_m=-0.25)
+        eta, vel, acc = _reference_sample(world, x, y, t, -0.25)
+        assert np.allclose(s.elevation_m, eta, rtol=0.0, atol=1e-12)
+        assert np.allclose(np.column_stack([s.velocity_x_mps, s.velocity_y_mps]), vel,
+                           rtol=0.0, atol=1e-12)
+        assert np.allclose(np.column_stack([s.accel_x_mps2, s.accel_y_mps2]), acc,
+                           rtol=0.0, atol=1e-12)
+    # grids keep their shape (the live scene samples a mesh)
+    gx, gy = np.meshgrid(np.linspace(0.0, 20.0, 5), np.linspace(-2.0, 2.0, 3))
+    grid = world.sample(gx, gy, 4.0).elevation_m
+    assert grid.shape == gx.shape
+    assert grid[1, 3] == pytest.approx(world.elevation_m(gx[1, 3], gy[1, 3], 4.0), abs=1e-12)
+
+
+def test_default_sea_is_the_one_of_before_the_spreading_option():
+    # waves.spreading_exponent_s = 0 (the default) keeps the sea of commit da3680a: these
+    # elevations were printed by that version's World for the same config and seed
+    world = SimCore.from_config(overrides={'waves.model': 'irregular'}, seed=1).world
+    eta = world.sample(np.array([5.0, 12.0, 20.0]), np.array([0.0, 0.6, -1.0]), 12.5)
+    assert eta.elevation_m == pytest.approx(
+        [-0.019371501576918866, 0.005617545545349607, 0.12081194374941635], abs=1e-14)
+
+
+def test_cos2s_spreading_is_normalised_and_has_its_spread():
+    theta = np.linspace(-math.pi, math.pi, 20001)
+    for s in (1.0, 10.0, 75.0):
+        d = cos2s_density(theta, s)
+        assert np.trapezoid(d, theta) == pytest.approx(1.0, rel=1e-6)
+        assert np.trapezoid(d * np.cos(theta), theta) == pytest.approx(s / (s + 1.0), rel=1e-6)
+    offsets = spreading_offsets_rad(10.0, 8)
+    assert np.allclose(offsets, -offsets[::-1])                 # symmetric about the mean
+    assert np.mean(np.cos(offsets)) == pytest.approx(10.0 / 11.0, abs=0.02)
+    assert np.all(np.diff(offsets) > 0.0)
+    with pytest.raises(ValueError):
+        cos2s_density(theta, 0.0)
+
+
+def test_short_crested_sea_keeps_hs_and_rocks_the_vehicle_sideways():
+    s_exp, directions = 10.0, 6
+    spread = irregular_waves(0.28, 3.6, 0.76, np.random.default_rng(4), count=48,
+                             spreading_exponent_s=s_exp, directions=directions)
+    long_crested = irregular_waves(0.28, 3.6, 0.76, np.random.default_rng(4), count=48)
+    energy = spread.amplitude_m ** 2
+    heading = np.arctan2(spread.ky, spread.kx)
+    # energy-weighted mean direction shoreward, spread as the cos-2s function has it
+    mean = math.atan2(np.sum(energy * np.sin(heading)), np.sum(energy * np.cos(heading)))
+    assert abs(math.remainder(mean - math.pi, 2 * math.pi)) < 0.1
+    cos_moment = np.sum(energy * np.cos(heading - math.pi)) / np.sum(energy)
+    assert cos_moment == pytest.approx(s_exp / (s_exp + 1.0), abs=0.05)
+    t = np.arange(0.0, 600.0, 0.1)
+    half_sep = 0.6                          # the hulls either side of the centreline
+    records = {}
+    for name, waves in (('spread', spread), ('long', long_crested)):
+        world = World(beach(), waves)
+        port = np.array([world.elevation_m(20.0, half_sep, ti) for ti in t])
+        stbd = np.array([world.elevation_m(20.0, -half_sep, ti) for ti in t])
+        records[name] = (port, stbd)
+        assert 4.0 * port.std() == pytest.approx(0.28, rel=0.15)     # same Hs either way
+        side = [world.sample(np.array([20.0]), np.zeros(1), ti, 1, -0.3).accel_y_mps2[0]
+                for ti in t[::10]]
+        records[name + '_ay'] = np.std(side)
+    port, stbd = records['long']
+    assert np.max(np.abs(port - stbd)) < 1e-12          # long-crested: no transverse slope
+    assert records['long_ay'] < 1e-12
+    port, stbd = records['spread']
+    assert np.std(port - stbd) > 0.05 * port.std()      # short-crested: roll and yaw forcing
+    assert records['spread_ay'] > 0.05
+
+
+@pytest.mark.parametrize('overrides', [
+    {'waves.spreading_exponent_s': 10.0, 'waves.directions': 6},          # with the uniform
+    {'waves.spreading_rad': 0.0, 'waves.spreading_exponent_s': 10.0},     # one direction
+    {'waves.directions': 4},                                              # bins, no s
+    {'waves.spreading_exponent_s': -1.0},
+])
+def test_inconsistent_spreading_settings_are_rejected(overrides):
+    with pytest.raises(ConfigError):
+        SimCore.from_config(overrides={'waves.model': 'irregular', **overrides})
+
+
+def test_a_short_crested_sea_is_built_from_the_config():
+    sim = SimCore.from_config(overrides={'waves.model': 'irregular', 'waves.spreading_rad': 0.0,
+                                         'waves.spreading_exponent_s': 25.0,
+                                         'waves.directions': 8}, seed=2)
+    waves = sim.world.waves
+    heading = np.arctan2(waves.ky, waves.kx)
+    assert len(np.unique(np.round(heading, 9))) == 8
+    assert waves.height_scale_m == pytest.approx(sim.params.waves.significant_height_m)
