@@ -1,11 +1,10 @@
 """One serial device's life: open, read, write, notice loss, reconnect with back-off (ROS-free).
 
 Every hardware node owns one ``SerialLink`` per device and calls ``poll()`` from a
-timer. The link never raises a serial error: a failed open, read or write marks
-it down, counts the error and keeps the text in ``last_error``; the next
-``poll()`` after the back-off (0.1 s doubling up to at most 1 s by default)
-tries to open the port again, so a node publishes again well within 2 s of a
-cable coming back. ``DeviceHealth`` turns the counters into a
+timer. The reconnecting life is ``reconnect.ReconnectingLink``'s: the link never raises a
+serial error, and the next ``poll()`` after the back-off (0.1 s doubling up to at most
+1 s by default) tries to open the port again, so a node publishes again well within 2 s
+of a cable coming back. ``DeviceHealth`` turns the counters into a
 ``dukw_common.diagnostics.Health`` for ``/diagnostics``.
 """
 from __future__ import annotations
@@ -17,6 +16,7 @@ import serial
 
 from dukw_common.config import ConfigError
 from dukw_common.diagnostics import Health, Level, RateCounter
+from dukw_driver.reconnect import DEVICE_ERRORS, ReconnectingLink
 
 #: Baud rates a UART on the vehicle can be set to.
 STANDARD_BAUDS = (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200, 230400, 460800, 921600)
@@ -41,7 +41,7 @@ def validate_baud(baud: object, name: str = 'baud') -> int:
     return baud
 
 
-class SerialLink:
+class SerialLink(ReconnectingLink):
     """Owns one serial device: open, read/write, reconnect with back-off; never raises."""
 
     def __init__(self, port: str, baud: int, *, backoff_initial_s: float = 0.1,
@@ -49,31 +49,20 @@ class SerialLink:
                  opener=serial.serial_for_url) -> None:
         self.port = validate_port(port)
         self.baud = validate_baud(baud)
-        if not 0 < backoff_initial_s <= backoff_max_s:
-            raise ConfigError('serial back-off needs 0 < backoff_initial_s <= backoff_max_s, '
-                              f'got {backoff_initial_s} and {backoff_max_s}')
-        self.backoff_initial_s = backoff_initial_s
-        self.backoff_max_s = backoff_max_s
-        self._clock = clock
+        super().__init__(self.port, backoff_initial_s, backoff_max_s, clock)
         self._opener = opener
-        self._device = None
-        self._backoff_s = backoff_initial_s
-        self._next_attempt_s = -float('inf')
-        self._ever_connected = False
-        self.connected = False
-        self.reconnects = 0          # successful opens after the first one
-        self.errors = 0              # failed opens, reads and writes
-        self.last_error = ''
-        self.bytes_in = 0
-        self.bytes_out = 0
+
+    def _open(self):
+        return self._opener(self.port, baudrate=self.baud, timeout=0,
+                            write_timeout=WRITE_TIMEOUT_S, exclusive=True)
 
     def poll(self) -> bytes:
         """Return the bytes available now (b'' if none or closed); reopen when back-off allows."""
-        if self._device is None and not self._try_open():
+        if not self._ensure_open():
             return b''
         try:
             data = self._device.read(READ_CHUNK)
-        except (serial.SerialException, OSError) as exc:
+        except DEVICE_ERRORS as exc:
             self._fail(f'read failed: {exc}')
             return b''
         self.bytes_in += len(data)
@@ -81,11 +70,11 @@ class SerialLink:
 
     def write(self, data: bytes) -> bool:
         """Send ``data``; False (and the link marked down) on error or when closed."""
-        if self._device is None and not self._try_open():
+        if not self._ensure_open():
             return False
         try:
             sent = self._device.write(data)
-        except (serial.SerialException, OSError) as exc:
+        except DEVICE_ERRORS as exc:
             self._fail(f'write failed: {exc}')
             return False
         if sent is not None and sent < len(data):
@@ -94,47 +83,6 @@ class SerialLink:
             return False
         self.bytes_out += len(data)
         return True
-
-    def close(self) -> None:
-        """Close the device (a later ``poll()`` or ``write()`` opens it again)."""
-        device, self._device = self._device, None
-        self.connected = False
-        if device is not None:
-            try:
-                device.close()
-            except (serial.SerialException, OSError):
-                pass  # closing a vanished device: nothing left to release
-
-    def seconds_until_retry(self) -> float:
-        """Seconds until the next open attempt (0 when connected or due)."""
-        if self.connected:
-            return 0.0
-        return max(0.0, self._next_attempt_s - self._clock())
-
-    def _try_open(self) -> bool:
-        now = self._clock()
-        if now < self._next_attempt_s:
-            return False
-        try:
-            self._device = self._opener(self.port, baudrate=self.baud, timeout=0,
-                                        write_timeout=WRITE_TIMEOUT_S, exclusive=True)
-        except (serial.SerialException, OSError, ValueError) as exc:
-            self.errors += 1
-            self.last_error = f'cannot open {self.port}: {exc}'
-            self._next_attempt_s = now + self._backoff_s
-            self._backoff_s = min(2.0 * self._backoff_s, self.backoff_max_s)
-            return False
-        self.connected = True
-        self.reconnects += int(self._ever_connected)
-        self._ever_connected = True
-        self._backoff_s = self.backoff_initial_s
-        return True
-
-    def _fail(self, message: str) -> None:
-        self.errors += 1
-        self.last_error = message
-        self.close()
-        self._next_attempt_s = self._clock() + self.backoff_initial_s
 
 
 class DeviceHealth:
