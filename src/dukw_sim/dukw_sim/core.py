@@ -643,7 +643,8 @@ class SimCore:
         idle = TrackState([0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0])
         return _Stepped(idle, [0.0, 0.0], w_eff, 0.0, 0.0, (0.0, 0.0, 0.0))
 
-    def _electrical(self, tracks: TrackState, thrust: list[float]):
+    def _electrical(self, tracks: TrackState,
+                    thrust: list[float]) -> tuple[list[float], list[float], float]:
         """Track motor currents, propeller currents (A) and the battery voltage (V)."""
         drive = self.vehicle.drivetrain
         speeds, motor = tracks.track_speed_mps, tracks.motor_force_n

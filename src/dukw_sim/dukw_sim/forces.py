@@ -12,7 +12,8 @@ the last bit of results that are recorded in the golden bags.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -25,12 +26,12 @@ _BREAKAWAY_MPS = 0.05          # below this track speed the breakaway friction a
 LATERAL_POINTS = 5             # points along each track for the lateral resistance
 
 
-@dataclass(frozen=True)
-class Wrench:
+class Wrench(NamedTuple):
     """One term of the horizontal force in body axes; None where the effect has no part.
 
     x_n, y_n, n_nm: surge force, sway force, yaw moment. dx_du, dy_dv, dn_dr: their
-    derivatives by surge speed, sway speed and yaw rate (N s/m, N m s/rad).
+    derivatives by surge speed, sway speed and yaw rate (N s/m, N m s/rad). A NamedTuple
+    (a dozen are made every step, and the sum walks their components in order).
     """
 
     x_n: float | None = None
@@ -53,20 +54,14 @@ class BodyForces:
     dn_dr: float
 
 
-_COMPONENTS = tuple(f.name for f in fields(Wrench))
-
-
 def sum_wrenches(terms: list[Wrench]) -> BodyForces:
     """Add the terms in order; the first term's components start the sums, absent ones 0.0."""
-    first = terms[0]
-    total = {name: 0.0 if getattr(first, name) is None else getattr(first, name)
-             for name in _COMPONENTS}
+    total = [0.0 if value is None else value for value in terms[0]]
     for term in terms[1:]:
-        for name in _COMPONENTS:
-            value = getattr(term, name)
+        for k, value in enumerate(term):
             if value is not None:
-                total[name] += value
-    return BodyForces(**total)
+                total[k] += value
+    return BodyForces(*total)
 
 
 @dataclass(frozen=True)
