@@ -56,11 +56,13 @@ class BodyForces:
 
 def sum_wrenches(terms: list[Wrench]) -> BodyForces:
     """Add the terms in order; the first term's components start the sums, absent ones 0.0."""
-    total = [0.0 if value is None else value for value in terms[0]]
-    for term in terms[1:]:
-        for k, value in enumerate(term):
+    total = []
+    for column in zip(*terms, strict=True):   # a component of every term, in their order
+        acc = 0.0 if column[0] is None else column[0]
+        for value in column[1:]:
             if value is not None:
-                total[k] += value
+                acc += value
+        total.append(acc)
     return BodyForces(*total)
 
 
