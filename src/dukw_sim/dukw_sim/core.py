@@ -29,8 +29,13 @@ from dukw_common.vehicle import SoilParams, Vehicle
 from dukw_driver.motors import prop_thrust_n
 from dukw_estimation import traction
 
+from dukw_sim.forces import (LATERAL_POINTS, BodyForces, Immersion, WaveForcing,
+                             drivetrain_friction_n, hydrodynamic_drag, immersion,
+                             lateral_resistance, odom_force, paddle_wrench, propulsion,
+                             rolling_resistance, slope_gravity, sum_wrenches, track_paddle_n,
+                             wave_forcing)
 from dukw_sim.hull import HullGeometry, Seakeeping
-from dukw_sim.land import TrackContact, linearise, motor_limited_speed
+from dukw_sim.land import TrackContact, TrackLinear, linearise, motor_limited_speed
 from dukw_sim.params import SimParams, apply_overrides
 from dukw_sim.truth import Medium, Truth
 from dukw_sim.world import (Beach, WaveModel, World, irregular_waves, no_waves,
@@ -38,10 +43,6 @@ from dukw_sim.world import (Beach, WaveModel, World, irregular_waves, no_waves,
 
 __all__ = ['Actuation', 'SimCore', 'SimParams', 'propeller_thrust_factor']
 
-_ROLL_EPS_MPS = 0.005          # regularisation of Coulomb rolling resistance
-_FRICTION_EPS_MPS = 0.02       # of drivetrain friction
-_BREAKAWAY_MPS = 0.05          # below this track speed the breakaway friction applies
-_LATERAL_POINTS = 5            # points along each track for the lateral resistance
 _LAND_FRACTION = 0.02          # submerged share of the afloat volume below which: LAND
 _NEWTON_PASSES = 3             # implicit track-soil solve
 _NEWTON_TOL_MPS = 2e-4
@@ -55,6 +56,30 @@ class TrackState:
     soil_force_n: list
     motor_force_n: list
     slip: list
+
+
+@dataclass(frozen=True)
+class _Drives:
+    """The track drives during a step, before the soil forces are solved for."""
+
+    ground: tuple                # speed of the ground under each track, m/s (body surge)
+    others: list                 # motor force besides the soil's: friction + paddling, N
+    paddle: list                 # the tracks' paddle force on the vehicle, N
+    loop_k: tuple                # speed-loop stiffness, N per m/s (inf: holds its speed)
+    contact: TrackContact | None
+    lin: TrackLinear             # the soil forces linearised at the step's ground speeds
+
+
+@dataclass(frozen=True)
+class _Stepped:
+    """What a step leaves for the Truth beyond the state."""
+
+    tracks: TrackState
+    thrust_n: list
+    w_eff_n: float
+    wave_fx_n: float             # wave force on the hull, odom
+    wave_fy_n: float
+    accel: tuple                 # surge, sway, heave acceleration, m/s^2
 
 
 @dataclass(frozen=True)
@@ -159,8 +184,8 @@ class SimCore:
                                        s.depth_sounder_x_m, prop.x_m, prop.x_m]])
         self._pts_y = np.concatenate([self.hull.station_y_m,
                                       [0.0, 0.0, 0.0, 0.0, self._half_sep, -self._half_sep]])
-        self._lat_s = [self._track_len * ((j + 0.5) / _LATERAL_POINTS - 0.5)
-                       for j in range(_LATERAL_POINTS)]
+        self._lat_s = [self._track_len * ((j + 0.5) / LATERAL_POINTS - 0.5)
+                       for j in range(LATERAL_POINTS)]
         self._external = (0.0, 0.0, 0.0)
         self._hydro_key = None
         self._hydro_val = None
@@ -283,79 +308,79 @@ class SimCore:
             raise ValueError(f'step needs an Actuation, got {type(act).__name__}')
         act.validated()
         dt = self.dt_s
-        p = self.params
-        veh = self.vehicle
-        u0, v0, r0, hv0 = self.u, self.v, self.r, self.heave_vel
+        u0, v0, hv0 = self.u, self.v, self.heave_vel
         c, s = math.cos(self.yaw), math.sin(self.yaw)
+        imm, w_eff = self._contact_and_immersion()
+        _, water, depths, areas = self._hydro()
+        body = self.vehicle.body
+        waves = wave_forcing(self.world.calm, areas, self.hull.strip_length_m, water,
+                             self.params.waves, body.water_density_kgpm3, self._rho_g,
+                             self._wave_a2, body.beam_m, imm)
+        # water velocity in body axes
+        uw = c * waves.water_u_mps + s * waves.water_v_mps
+        vw = -s * waves.water_u_mps + c * waves.water_v_mps
+        u_rel, v_rel = u0 - uw, v0 - vw
+        drives = self._track_drives(act, u_rel, w_eff, depths)
+        thrust = self._thrust_n(act, water.elevation_m)
+        forces = self._body_forces(drives, imm, waves, thrust, w_eff, (u_rel, v_rel), (c, s))
+        tracks = self._integrate_plane(forces, drives, imm.fraction, (c, s))
+        if self.in_contact:
+            self._follow_ground()
+        else:
+            self._float_free(imm)
+        self.t_s += dt
+        accel = ((self.u - u0) / dt - self.r * self.v, (self.v - v0) / dt + self.r * self.u,
+                 (self.heave_vel - hv0) / dt)
+        self.truth = self._compute_truth(act, _Stepped(tracks, thrust, w_eff, waves.fx_n,
+                                                       waves.fy_n, accel))
+        return self.truth
 
-        # --- water at the strips and sample points
+    def _contact_and_immersion(self) -> tuple[Immersion, float]:
+        """Put a grounded vehicle on the beach, take the water's buoyancy, lift off when it
+        carries the weight; return the immersion and the weight on the tracks, N."""
         gz, gpitch, groll, slope = self._ground_pose()
         if self.in_contact:
             self.z_cg, self.pitch, self.roll = gz + self._kg, gpitch, groll
-        px, water, depths, areas = self._hydro()
-        strip_f = self._rho_g * self.hull.strip_length_m * areas
-        buoy = float(strip_f.sum())
-        volume = buoy / self._rho_g
-        frac = min(volume / self._afloat_volume, 1.0)
-
-        # --- contact: lift off when the water carries the weight
-        if self.in_contact and buoy >= self._weight:
+        areas = self._hydro()[3]
+        imm = immersion(areas, self.hull.strip_length_m, self._rho_g, self._afloat_volume)
+        if self.in_contact and imm.buoyancy_n >= self._weight:
             self.in_contact = False
-        if self.in_contact or self.grazing:
-            w_eff = max(traction.effective_weight_n(self._weight, volume, slope,
-                                                    veh.body.water_density_kgpm3, self._g), 0.0)
-        else:
-            w_eff = 0.0
+        if not (self.in_contact or self.grazing):
+            return imm, 0.0
+        return imm, max(traction.effective_weight_n(
+            self._weight, imm.volume_m3, slope, self.vehicle.body.water_density_kgpm3,
+            self._g), 0.0)
 
-        # --- wave forces on the hull strips (Froude-Krylov + diffraction), odom
-        cm_rho = p.waves.surge_inertia_coeff * veh.body.water_density_kgpm3
-        if self.world.calm:
-            fwx = fwy = 0.0
-            wu = wv = 0.0
-        else:
-            vol_strip = areas * self.hull.strip_length_m
-            fwx = cm_rho * float(vol_strip @ water.accel_x_mps2)
-            fwy = cm_rho * float(vol_strip @ water.accel_y_mps2)
-            drift = (p.waves.drift_force_coeff * 0.5 * self._rho_g
-                     * self._wave_a2
-                     * veh.body.beam_m * frac)
-            fwx -= drift                                    # shoreward, with the waves
-            if volume > 1e-9:
-                area_sum = float(areas.sum())
-                wu = float(areas @ water.velocity_x_mps) / area_sum
-                wv = float(areas @ water.velocity_y_mps) / area_sum
-            else:
-                wu = wv = 0.0
-        # water velocity in body axes
-        uw = c * wu + s * wv
-        vw = -s * wu + c * wv
-        u_rel, v_rel = u0 - uw, v0 - vw
-
-        # --- track drives
-        land = p.land
-        drive = veh.drivetrain
-        full = drive.full_scale_track_speed_mps
+    def _advance_speed_refs(self, act: Actuation) -> list[float]:
+        """Move the track speed loops' references toward the commands; return the targets."""
+        land = self.params.land
+        full = self.vehicle.drivetrain.full_scale_track_speed_mps
         targets = [act.port_track_pct / 100.0 * full, act.stbd_track_pct / 100.0 * full]
         if targets[0] != 0.0:
             targets[0] -= math.copysign(min(abs(targets[0]), self._port_droop_mps), targets[0])
-        alpha = min(dt / land.speed_loop_time_constant_s, 1.0)
-        max_dv = land.speed_loop_accel_mps2 * dt
+        alpha = min(self.dt_s / land.speed_loop_time_constant_s, 1.0)
+        max_dv = land.speed_loop_accel_mps2 * self.dt_s
         self.ref = [self.ref[i] + max(-max_dv, min(max_dv, (targets[i] - self.ref[i]) * alpha))
                     for i in range(2)]
-        ground = (u0 - r0 * self._half_sep, u0 + r0 * self._half_sep)
+        return targets
+
+    def _track_drives(self, act: Actuation, u_rel: float, w_eff: float,
+                      depths: np.ndarray) -> _Drives:
+        """The track drives this step: speed loops, friction, paddling, soil contact."""
+        p, drive = self.params, self.vehicle.drivetrain
+        targets = self._advance_speed_refs(act)
+        ground = (self.u - self.r * self._half_sep, self.u + self.r * self._half_sep)
         track_imm = min(max(float(depths.mean()) / self.seakeeping.equilibrium_depth_m, 0.0), 1.0)
         others = []
         paddle = []
         for i in range(2):
-            fric = drive.friction_n + (drive.port_extra_friction_n if i == 0 else 0.0)
             # a loaded loop's speed follows the load: take its reference (no feedback chatter)
             ts = self.ref[i] if math.isfinite(self._loop_k) else self.track_speed[i]
-            if abs(ts) < _BREAKAWAY_MPS:
-                fric *= 1.0 + (land.breakaway_friction_ratio - 1.0) * (
-                    1.0 - abs(ts) / _BREAKAWAY_MPS)
-            fric *= math.tanh(self.ref[i] / _FRICTION_EPS_MPS)
-            rel = self.ref[i] - u_rel
-            pad = p.water.track_paddle_coeff_n_per_mps2 * rel * abs(rel) * track_imm
+            fric = drivetrain_friction_n(
+                drive.friction_n + (drive.port_extra_friction_n if i == 0 else 0.0), ts,
+                self.ref[i], p.land.breakaway_friction_ratio)
+            pad = track_paddle_n(p.water.track_paddle_coeff_n_per_mps2, self.ref[i], u_rel,
+                                 track_imm)
             paddle.append(pad)
             others.append(fric + pad)
         soil = self._dry_soil if self.x < p.world.wet_sand_start_x_m else self._wet_soil
@@ -365,78 +390,67 @@ class SimCore:
         loop_k = tuple(self._loop_k if targets[i] != 0.0 else math.inf for i in range(2))
         lin = linearise(contact, tuple(self.ref), ground, tuple(others), loop_k,
                         tuple(self.track_speed))
+        return _Drives(ground, others, paddle, loop_k, contact, lin)
 
-        # --- forces in body axes (X forward, Y left, N yaw) and their derivatives, all but
-        # the tracks' soil forces (added in the implicit solve below)
-        X = paddle[0] + paddle[1]
-        Y = 0.0
-        N = (paddle[1] - paddle[0]) * self._half_sep
-        j_u = j_v = j_r = 0.0
+    def _thrust_n(self, act: Actuation, eta: np.ndarray) -> list[float]:
+        """Port and starboard propeller thrust, N, with their depth under the surface."""
+        drive = self.vehicle.drivetrain
+        prop_share = self._prop_thrust_factors(eta)
+        return [prop_thrust_n(act.port_prop_pct, drive) * prop_share[0],
+                prop_thrust_n(act.stbd_prop_pct, drive) * prop_share[1]]
+
+    def _body_forces(self, drives: _Drives, imm: Immersion, waves: WaveForcing,
+                     thrust: list[float], w_eff: float, rel_water: tuple,
+                     yaw_cs: tuple) -> BodyForces:
+        """Every horizontal force in body axes but the tracks' soil forces (those go into the
+        implicit solve), summed by effect in one place. A new force is one more term here."""
+        land, wat, half = self.params.land, self.params.water, self._half_sep
+        c, s = yaw_cs
+        terms = [paddle_wrench(drives.paddle, half)]
         if w_eff > 0.0:
-            roll_n = land.rolling_resistance_coeff * w_eff / 2.0
-            for i, sign in ((0, -1.0), (1, 1.0)):
-                th = math.tanh(ground[i] / _ROLL_EPS_MPS)
-                f = -roll_n * th
-                X += f
-                N += sign * f * self._half_sep
-                dth = roll_n * (1.0 - th * th) / _ROLL_EPS_MPS
-                j_u -= dth
-                j_r -= dth * self._half_sep ** 2
-            lat_n = land.lateral_friction_coeff * w_eff / _LATERAL_POINTS
-            v_ref = land.lateral_slip_speed_mps
-            lat_c = land.lateral_damping_n_per_mps * w_eff / self._weight / _LATERAL_POINTS
-            for s_j in self._lat_s:
-                th = math.tanh((v0 + r0 * s_j) / v_ref)
-                f = -lat_n * th - lat_c * (v0 + r0 * s_j)
-                Y += f
-                N += f * s_j
-                d = lat_n * (1.0 - th * th) / v_ref + lat_c
-                j_v -= d
-                j_r -= d * s_j * s_j
-            # gravity along the slope: (Delta - B) sin(theta), downhill, odom -> body
-            grad = self.world.beach.gradient(self.x)
-            if grad != 0.0:
-                down = -(self._weight - buoy) * grad / math.sqrt(1.0 + grad * grad)
-                X += c * down
-                Y += -s * down
-        # water: propellers, drag, walk
-        wat = p.water
-        prop_share = self._prop_thrust_factors(water.elevation_m)
-        thrust = [prop_thrust_n(act.port_prop_pct, drive) * prop_share[0],
-                  prop_thrust_n(act.stbd_prop_pct, drive) * prop_share[1]]
-        X += thrust[0] + thrust[1]
-        N += (thrust[1] - thrust[0]) * self._half_sep
-        walk = -wat.prop_walk_ratio * (thrust[0] + thrust[1])
-        Y += walk
-        N += walk * p.propeller.x_m
-        X -= (wat.surge_linear_drag_n_per_mps * u_rel
-              + wat.surge_quadratic_drag_n_per_mps2 * abs(u_rel) * u_rel) * frac
-        Y -= (wat.sway_linear_drag_n_per_mps * v_rel
-              + wat.sway_quadratic_drag_n_per_mps2 * abs(v_rel) * v_rel) * frac
-        N -= (wat.yaw_linear_drag_nm_per_rps * r0
-              + wat.yaw_quadratic_drag_nm_per_rps2 * abs(r0) * r0) * frac
-        j_u -= (wat.surge_linear_drag_n_per_mps
-                + 2.0 * wat.surge_quadratic_drag_n_per_mps2 * abs(u_rel)) * frac
-        j_v -= (wat.sway_linear_drag_n_per_mps
-                + 2.0 * wat.sway_quadratic_drag_n_per_mps2 * abs(v_rel)) * frac
-        j_r -= (wat.yaw_linear_drag_nm_per_rps
-                + 2.0 * wat.yaw_quadratic_drag_nm_per_rps2 * abs(r0)) * frac
-        # waves and external forces, odom -> body
+            terms += rolling_resistance(w_eff, drives.ground, land, half)
+            terms += lateral_resistance(w_eff, self.v, self.r, self._lat_s, land, self._weight)
+            terms += slope_gravity(self._weight, imm.buoyancy_n,
+                                   self.world.beach.gradient(self.x), c, s)
+        terms += propulsion(thrust, wat.prop_walk_ratio, self.params.propeller.x_m, half)
+        terms.append(hydrodynamic_drag(rel_water[0], rel_water[1], self.r, imm.fraction, wat))
         ex, ey, en = self._external
-        X += c * (fwx + ex) + s * (fwy + ey)
-        Y += -s * (fwx + ex) + c * (fwy + ey)
-        N += en
+        terms.append(odom_force(waves.fx_n + ex, waves.fy_n + ey, en, c, s))
+        return sum_wrenches(terms)
 
-        # --- planar rigid body with added mass (semi-implicit Euler)
+    def _integrate_plane(self, forces: BodyForces, drives: _Drives, frac: float,
+                         yaw_cs: tuple) -> TrackState:
+        """Planar rigid body with added mass (semi-implicit Euler): new surge, sway, yaw rate,
+        track speeds and pose; return the tracks' state."""
+        dt, wat, half = self.dt_s, self.params.water, self._half_sep
+        u0, v0, r0 = self.u, self.v, self.r
         m_x = self._mass * (1.0 + wat.surge_added_mass_ratio * frac)
         m_y = self._mass * (1.0 + wat.sway_added_mass_ratio * frac)
         i_z = wat.yaw_inertia_kg_m2 * (1.0 + wat.yaw_added_inertia_ratio * frac)
-        dv = dt * (Y - m_x * u0 * r0) / (m_y - dt * j_v)
-        # implicit in the soil forces: Newton passes, each linearising the soil forces at the
-        # previous pass's ground speeds; a track whose motor cannot give what the soil would
-        # take is held at the motor's limit (its derivative drops out)
-        base = (X + m_y * v0 * r0, N, m_x, i_z, j_u, j_r)
-        half = self._half_sep
+        dv = dt * (forces.y_n - m_x * u0 * r0) / (m_y - dt * forces.dy_dv)
+        base = (forces.x_n + m_y * v0 * r0, forces.n_nm, m_x, i_z, forces.dx_du, forces.dn_dr)
+        du, dr, new, limited = self._solve_surge_yaw(base, drives)
+        others, contact, loop_k = drives.others, drives.contact, drives.loop_k
+        self.u, self.v, self.r = u0 + du, v0 + dv, r0 + dr
+        ground_new = (self.u - self.r * half, self.u + self.r * half)
+        speeds = [motor_limited_speed(contact, self.ref[i], ground_new[i], new[i])
+                  if limited[i] else self._loaded_speed(i, new[i] + others[i], loop_k[i])
+                  for i in range(2)]
+        self.track_speed = speeds
+        slips = traction.slip(np.array(speeds), np.array(ground_new)).tolist()
+        c, s = yaw_cs
+        self.yaw = (self.yaw + dt * self.r + math.pi) % (2.0 * math.pi) - math.pi
+        self.x += dt * (c * self.u - s * self.v)
+        self.y += dt * (s * self.u + c * self.v)
+        return TrackState(speeds, new, [new[i] + others[i] for i in range(2)], slips)
+
+    def _solve_surge_yaw(self, base: tuple, drives: _Drives):
+        """Surge and yaw-rate change, implicit in the soil forces: Newton passes, each
+        linearising the soil forces at the previous pass's ground speeds; a track whose motor
+        cannot give what the soil would take is held at the motor's limit (its derivative
+        drops out). Where that fails the tracks grip. Returns (du, dr, forces, limited)."""
+        u0, r0, half = self.u, self.r, self._half_sep
+        contact, lin, ground, others = drives.contact, drives.lin, drives.ground, drives.others
         g_lin = ground
         converged = contact is None
         for _ in range(_NEWTON_PASSES):
@@ -449,63 +463,50 @@ class SimCore:
                 converged = True
                 break
             g_lin = g_next
-            lin = linearise(contact, tuple(self.ref), g_lin, tuple(others), loop_k,
+            lin = linearise(contact, tuple(self.ref), g_lin, tuple(others), drives.loop_k,
                             tuple(lin.speed_mps))
         if contact is not None and any(
                 (lin.speed_mps[i] - ground[i]) * (lin.speed_mps[i] - ground[i] - du
                                                   + (1.0, -1.0)[i] * dr * half) < 0.0
                 for i in range(2)):
             converged = False          # a track's slip would change sign within the step
-        if not converged:
-            # the soil force is nearly a step at these slips (firm sand, low speed): the
-            # tracks grip; solve the step with the ground under the tracks moving at the
-            # tracks' (loaded) speeds, within what the soil and the motors can give
-            if any(math.isinf(k) for k in loop_k):
-                du, dr, new, limited = self._grip_step(base, contact, u0, r0, others)
-            else:
-                du, dr, new, limited = self._loaded_grip_step(base, contact, u0, r0, others,
-                                                              loop_k)
-        self.u, self.v, self.r = u0 + du, v0 + dv, r0 + dr
-        half = self._half_sep
-        ground_new = (self.u - self.r * half, self.u + self.r * half)
-        speeds = [motor_limited_speed(contact, self.ref[i], ground_new[i], new[i])
-                  if limited[i] else self._loaded_speed(i, new[i] + others[i], loop_k[i])
-                  for i in range(2)]
-        self.track_speed = speeds
-        slips = traction.slip(np.array(speeds), np.array(ground_new)).tolist()
-        tracks = TrackState(speeds, new, [new[i] + others[i] for i in range(2)], slips)
-        self.yaw = (self.yaw + dt * self.r + math.pi) % (2.0 * math.pi) - math.pi
-        self.x += dt * (c * self.u - s * self.v)
-        self.y += dt * (s * self.u + c * self.v)
+        if converged:
+            return du, dr, new, limited
+        # the soil force is nearly a step at these slips (firm sand, low speed): the tracks
+        # grip; solve the step with the ground under the tracks moving at the tracks'
+        # (loaded) speeds, within what the soil and the motors can give
+        if any(math.isinf(k) for k in drives.loop_k):
+            return self._grip_step(base, contact, u0, r0, others)
+        return self._loaded_grip_step(base, contact, u0, r0, others, drives.loop_k)
 
-        # --- heave, roll, pitch
-        sk = self.seakeeping
-        if self.in_contact:
-            ngz, npitch, nroll, _ = self._ground_pose()
-            nz = ngz + self._kg
-            self.heave_vel = (nz - self.z_cg) / dt
-            self.roll_rate = (nroll - self.roll) / dt
-            self.pitch_rate = (npitch - self.pitch) / dt
-            self.z_cg, self.pitch, self.roll = nz, npitch, nroll
-        else:
-            m_roll = float(strip_f @ self.hull.station_y_m)
-            m_pitch = -float(strip_f @ self.hull.station_x_m)
-            self.heave_vel += dt * (buoy - self._weight - sk.heave_damping_n_per_mps
-                                    * self.heave_vel * frac) / sk.heave_mass_kg
-            self.roll_rate += dt * (m_roll - sk.roll_damping_nm_per_rps
-                                    * self.roll_rate * frac) / sk.roll_inertia_kg_m2
-            self.pitch_rate += dt * (m_pitch - sk.pitch_damping_nm_per_rps
-                                     * self.pitch_rate * frac) / sk.pitch_inertia_kg_m2
-            self.z_cg += dt * self.heave_vel
-            self.roll += dt * self.roll_rate
-            self.pitch += dt * self.pitch_rate
-            self.grazing = False
-            self._touchdown()
-        self.t_s += dt
-        accel = ((self.u - u0) / dt - self.r * self.v, (self.v - v0) / dt + self.r * self.u,
-                 (self.heave_vel - hv0) / dt)
-        self.truth = self._compute_truth(act, (tracks, thrust, w_eff, fwx, fwy, accel))
-        return self.truth
+    def _follow_ground(self) -> None:
+        """On the ground: take the beach's pose; the rates are the pose's change over the step."""
+        dt = self.dt_s
+        ngz, npitch, nroll, _ = self._ground_pose()
+        nz = ngz + self._kg
+        self.heave_vel = (nz - self.z_cg) / dt
+        self.roll_rate = (nroll - self.roll) / dt
+        self.pitch_rate = (npitch - self.pitch) / dt
+        self.z_cg, self.pitch, self.roll = nz, npitch, nroll
+
+    def _float_free(self, imm: Immersion) -> None:
+        """Afloat: heave, roll and pitch under the strips' buoyancy, with damping scaled by
+        the submerged share, then touch down if a track end reaches the sand."""
+        dt, sk, frac = self.dt_s, self.seakeeping, imm.fraction
+        strip_f = imm.strip_force_n
+        m_roll = float(strip_f @ self.hull.station_y_m)
+        m_pitch = -float(strip_f @ self.hull.station_x_m)
+        self.heave_vel += dt * (imm.buoyancy_n - self._weight - sk.heave_damping_n_per_mps
+                                * self.heave_vel * frac) / sk.heave_mass_kg
+        self.roll_rate += dt * (m_roll - sk.roll_damping_nm_per_rps
+                                * self.roll_rate * frac) / sk.roll_inertia_kg_m2
+        self.pitch_rate += dt * (m_pitch - sk.pitch_damping_nm_per_rps
+                                 * self.pitch_rate * frac) / sk.pitch_inertia_kg_m2
+        self.z_cg += dt * self.heave_vel
+        self.roll += dt * self.roll_rate
+        self.pitch += dt * self.pitch_rate
+        self.grazing = False
+        self._touchdown()
 
     def _solve_tracks(self, base: tuple, lin, g_lin: tuple, g_old: tuple, others: list):
         """Implicit surge and yaw-rate change with the soil forces linearised at ``g_lin``.
@@ -634,46 +635,20 @@ class SimCore:
         self.heave_vel = self.roll_rate = self.pitch_rate = 0.0
 
     # ---------------------------------------------------------------------- truth
-    def _compute_truth(self, act: Actuation, stepped) -> Truth:
-        veh = self.vehicle
-        drive = veh.drivetrain
-        sens = veh.sensors
-        c, s = math.cos(self.yaw), math.sin(self.yaw)
-        px, water, depths, areas = self._hydro()
-        n = self._n_stations
-        eta = water.elevation_m[n:].tolist()     # base_link, fore, aft, sounder
-        volume = float(areas.sum()) * self.hull.strip_length_m
-        beach = self.world.beach
-        ground = beach.height_m(self.x)
-        base_z = self.z_cg - self._kg
-        sp, cp = math.sin(self.pitch), math.cos(self.pitch)
-        sr, cr = math.sin(self.roll), math.cos(self.roll)
+    def _at_rest(self, volume: float) -> _Stepped:
+        """What a step would have left after reset or perturb: no motion, no forces."""
+        w_eff = traction.effective_weight_n(
+            self._weight, volume, math.atan(abs(self.world.beach.gradient(self.x))),
+            self.vehicle.body.water_density_kgpm3, self._g) \
+            if self.in_contact or self.grazing else 0.0
+        idle = TrackState([0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0])
+        return _Stepped(idle, [0.0, 0.0], w_eff, 0.0, 0.0, (0.0, 0.0, 0.0))
 
-        def sensor_z(bx: float, bz: float) -> float:
-            return base_z - bx * sp + bz * cp * cr
-
-        sounder_z = sensor_z(sens.depth_sounder_x_m, sens.depth_sounder_z_m)
-        sounder_ground = beach.height_m(float(px[n + 3]))
-        if eta[3] > sounder_z:
-            sounder = sounder_z - sounder_ground
-        else:
-            sounder = eta[3] - sounder_z
-        if stepped is None:
-            tracks = None
-            thrust = [0.0, 0.0]
-            w_eff = traction.effective_weight_n(self._weight, volume, math.atan(abs(
-                beach.gradient(self.x))), veh.body.water_density_kgpm3, self._g) \
-                if self.in_contact or self.grazing else 0.0
-            fwx = fwy = 0.0
-            accel = (0.0, 0.0, 0.0)
-        else:
-            tracks, thrust, w_eff, fwx, fwy, accel = stepped
-        g_up = self._g + accel[2]
-        if tracks is not None:
-            speeds, forces, motor, slips = (tracks.track_speed_mps, tracks.soil_force_n,
-                                            tracks.motor_force_n, tracks.slip)
-        else:
-            speeds, forces, motor, slips = [0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0]
+    def _electrical(self, tracks: TrackState,
+                    thrust: list[float]) -> tuple[list[float], list[float], float]:
+        """Track motor currents, propeller currents (A) and the battery voltage (V)."""
+        drive = self.vehicle.drivetrain
+        speeds, motor = tracks.track_speed_mps, tracks.motor_force_n
         gain = drive.track_force_gain_n_per_a
         currents = [motor[i] / gain
                     + drive.no_load_current_a * math.tanh(speeds[i] / drive.friction_fade_mps)
@@ -682,17 +657,52 @@ class SimCore:
                   * min(abs(thrust[i]) / drive.max_prop_thrust_n, 1.0) ** 1.5 for i in range(2)]
         battery = drive.motor_voltage_v - self.params.battery_internal_resistance_ohm * (
             abs(currents[0]) + abs(currents[1]) + prop_i[0] + prop_i[1])
+        return currents, prop_i, battery
+
+    def _medium(self, touching: bool, volume: float) -> str:
+        if not touching:
+            return Medium.WATER
+        if volume < _LAND_FRACTION * self._afloat_volume:
+            return Medium.LAND
+        return Medium.TRANSITION
+
+    def _sensor_depths(self, px: np.ndarray, eta: list) -> tuple[float, float, float]:
+        """Fore and aft water sensors' depth under the surface, and the sounder's reading:
+        the depth of the water under it, or (out of the water) minus its height above it."""
+        sens = self.vehicle.sensors
+        base_z = self.z_cg - self._kg
+        sp, cp, cr = math.sin(self.pitch), math.cos(self.pitch), math.cos(self.roll)
+
+        def sensor_z(bx: float, bz: float) -> float:
+            return base_z - bx * sp + bz * cp * cr
+
+        sounder_z = sensor_z(sens.depth_sounder_x_m, sens.depth_sounder_z_m)
+        sounder_ground = self.world.beach.height_m(float(px[self._n_stations + 3]))
+        if eta[3] > sounder_z:
+            sounder = sounder_z - sounder_ground
+        else:
+            sounder = eta[3] - sounder_z
+        return (eta[1] - sensor_z(sens.fore_water_x_m, sens.fore_water_z_m),
+                eta[2] - sensor_z(sens.aft_water_x_m, sens.aft_water_z_m), sounder)
+
+    def _compute_truth(self, act: Actuation, stepped: _Stepped | None) -> Truth:
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        px, water, depths, areas = self._hydro()
+        eta = water.elevation_m[self._n_stations:].tolist()   # base_link, fore, aft, sounder
+        volume = float(areas.sum()) * self.hull.strip_length_m
+        beach = self.world.beach
+        ground = beach.height_m(self.x)
+        sp, cp = math.sin(self.pitch), math.cos(self.pitch)
+        sr, cr = math.sin(self.roll), math.cos(self.roll)
+        fore, aft, sounder = self._sensor_depths(px, eta)
+        st = self._at_rest(volume) if stepped is None else stepped
+        accel, tracks, thrust, w_eff = st.accel, st.tracks, st.thrust_n, st.w_eff_n
+        g_up = self._g + accel[2]
+        currents, prop_i, battery = self._electrical(tracks, thrust)
         # touching now, or during the step just taken (its track forces acted on the sand)
         touching = self.in_contact or self.grazing or w_eff > 0.0
-        if not touching:
-            medium = Medium.WATER
-        elif volume < _LAND_FRACTION * self._afloat_volume:
-            medium = Medium.LAND
-        else:
-            medium = Medium.TRANSITION
-        slope = math.atan(abs(beach.gradient(self.x)))
         return Truth(
-            t_s=self.t_s, x_m=self.x, y_m=self.y, z_m=base_z,
+            t_s=self.t_s, x_m=self.x, y_m=self.y, z_m=self.z_cg - self._kg,
             roll_rad=self.roll, pitch_rad=self.pitch, yaw_rad=self.yaw,
             surge_mps=self.u, sway_mps=self.v, heave_mps=self.heave_vel,
             roll_rate_rps=self.roll_rate, pitch_rate_rps=self.pitch_rate,
@@ -701,9 +711,10 @@ class SimCore:
             accel_y_mps2=accel[1] + g_up * sr * cp,
             accel_z_mps2=g_up * cr * cp,
             port_cmd_pct=act.port_track_pct, stbd_cmd_pct=act.stbd_track_pct,
-            port_track_speed_mps=speeds[0], stbd_track_speed_mps=speeds[1],
-            port_slip=slips[0], stbd_slip=slips[1],
-            port_force_n=forces[0], stbd_force_n=forces[1],
+            port_track_speed_mps=tracks.track_speed_mps[0],
+            stbd_track_speed_mps=tracks.track_speed_mps[1],
+            port_slip=tracks.slip[0], stbd_slip=tracks.slip[1],
+            port_force_n=tracks.soil_force_n[0], stbd_force_n=tracks.soil_force_n[1],
             port_current_a=currents[0], stbd_current_a=currents[1],
             port_prop_cmd_pct=act.port_prop_pct, stbd_prop_cmd_pct=act.stbd_prop_pct,
             port_thrust_n=thrust[0], stbd_thrust_n=thrust[1],
@@ -713,11 +724,8 @@ class SimCore:
             weight_on_tracks_fraction=(max(self._weight - self._rho_g * volume, 0.0)
                                        / self._weight if touching else 0.0),
             waterline_distance_m=beach.distance_along_slope_m(self.x),
-            slope_rad=slope, ground_height_m=ground,
+            slope_rad=math.atan(abs(beach.gradient(self.x))), ground_height_m=ground,
             wave_elevation_m=eta[0], water_depth_m=eta[0] - ground,
-            fore_sensor_depth_m=eta[1] - sensor_z(sens.fore_water_x_m,
-                                                              sens.fore_water_z_m),
-            aft_sensor_depth_m=eta[2] - sensor_z(sens.aft_water_x_m,
-                                                             sens.aft_water_z_m),
-            sounder_depth_m=sounder, medium=medium,
-            wave_surge_force_n=c * fwx + s * fwy, in_ground_contact=touching)
+            fore_sensor_depth_m=fore, aft_sensor_depth_m=aft,
+            sounder_depth_m=sounder, medium=self._medium(touching, volume),
+            wave_surge_force_n=c * st.wave_fx_n + s * st.wave_fy_n, in_ground_contact=touching)

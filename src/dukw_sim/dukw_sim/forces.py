@@ -1,0 +1,215 @@
+"""The horizontal forces on the DUKW-Ling, one pure function per physical effect (ROS-free).
+
+Each effect returns its terms as ``Wrench`` records in body axes (X forward, Y left, N yaw,
+with the derivatives the implicit solve needs); ``sum_wrenches`` adds them in one place, in
+the order they are given. A new force is a new function returning wrenches, appended to the
+list ``SimCore`` sums (``SimCore._body_forces``).
+
+A wrench names only the components its effect has (the others are None, not 0.0), so the sum
+adds exactly the terms the effect contributes: adding a 0.0 would flip a signed zero and change
+the last bit of results that are recorded in the golden bags.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+from dukw_sim.params import LandParams, WaterParams, WaveParams
+from dukw_sim.world import WaterSample
+
+_ROLL_EPS_MPS = 0.005          # regularisation of Coulomb rolling resistance
+_FRICTION_EPS_MPS = 0.02       # of drivetrain friction
+_BREAKAWAY_MPS = 0.05          # below this track speed the breakaway friction applies
+LATERAL_POINTS = 5             # points along each track for the lateral resistance
+
+
+class Wrench(NamedTuple):
+    """One term of the horizontal force in body axes; None where the effect has no part.
+
+    x_n, y_n, n_nm: surge force, sway force, yaw moment. dx_du, dy_dv, dn_dr: their
+    derivatives by surge speed, sway speed and yaw rate (N s/m, N m s/rad). A NamedTuple
+    (a dozen are made every step, and the sum walks their components in order).
+    """
+
+    x_n: float | None = None
+    y_n: float | None = None
+    n_nm: float | None = None
+    dx_du: float | None = None
+    dy_dv: float | None = None
+    dn_dr: float | None = None
+
+
+@dataclass(frozen=True)
+class BodyForces:
+    """The sum of all wrenches of a step (body axes), with its derivatives."""
+
+    x_n: float
+    y_n: float
+    n_nm: float
+    dx_du: float
+    dy_dv: float
+    dn_dr: float
+
+
+def sum_wrenches(terms: list[Wrench]) -> BodyForces:
+    """Add the terms in order; the first term's components start the sums, absent ones 0.0."""
+    total = []
+    for column in zip(*terms, strict=True):   # a component of every term, in their order
+        acc = 0.0 if column[0] is None else column[0]
+        for value in column[1:]:
+            if value is not None:
+                acc += value
+        total.append(acc)
+    return BodyForces(*total)
+
+
+@dataclass(frozen=True)
+class Immersion:
+    """The hull strips in the water: their buoyancy, the volume and its afloat share."""
+
+    strip_force_n: np.ndarray   # buoyancy of each hull strip, N
+    buoyancy_n: float
+    volume_m3: float
+    fraction: float             # submerged share of the afloat volume, 0..1
+
+
+def immersion(areas_m2: np.ndarray, strip_length_m: float, rho_g: float,
+              afloat_volume_m3: float) -> Immersion:
+    """Buoyancy of the hull strips with these immersed section areas."""
+    strip_f = rho_g * strip_length_m * areas_m2
+    buoy = float(strip_f.sum())
+    volume = buoy / rho_g
+    return Immersion(strip_f, buoy, volume, min(volume / afloat_volume_m3, 1.0))
+
+
+@dataclass(frozen=True)
+class WaveForcing:
+    """Wave force on the hull in odom (N) and the mean water velocity at it (m/s)."""
+
+    fx_n: float
+    fy_n: float
+    water_u_mps: float
+    water_v_mps: float
+
+
+def wave_forcing(calm: bool, areas_m2: np.ndarray, strip_length_m: float, water: WaterSample,
+                 waves: WaveParams, rho_kgpm3: float, rho_g: float, amplitude_sq_m2: float,
+                 beam_m: float, imm: Immersion) -> WaveForcing:
+    """Froude-Krylov + diffraction on the hull strips, less the mean drift (shoreward)."""
+    if calm:
+        return WaveForcing(0.0, 0.0, 0.0, 0.0)
+    cm_rho = waves.surge_inertia_coeff * rho_kgpm3
+    vol_strip = areas_m2 * strip_length_m
+    fwx = cm_rho * float(vol_strip @ water.accel_x_mps2)
+    fwy = cm_rho * float(vol_strip @ water.accel_y_mps2)
+    drift = (waves.drift_force_coeff * 0.5 * rho_g
+             * amplitude_sq_m2
+             * beam_m * imm.fraction)
+    fwx -= drift                                    # shoreward, with the waves
+    if imm.volume_m3 > 1e-9:
+        area_sum = float(areas_m2.sum())
+        wu = float(areas_m2 @ water.velocity_x_mps) / area_sum
+        wv = float(areas_m2 @ water.velocity_y_mps) / area_sum
+    else:
+        wu = wv = 0.0
+    return WaveForcing(fwx, fwy, wu, wv)
+
+
+def drivetrain_friction_n(friction_n: float, track_speed_mps: float, ref_mps: float,
+                          breakaway_ratio: float) -> float:
+    """Friction of one track's drivetrain (breakaway near standstill), against the reference."""
+    fric = friction_n
+    if abs(track_speed_mps) < _BREAKAWAY_MPS:
+        fric *= 1.0 + (breakaway_ratio - 1.0) * (
+            1.0 - abs(track_speed_mps) / _BREAKAWAY_MPS)
+    fric *= math.tanh(ref_mps / _FRICTION_EPS_MPS)
+    return fric
+
+
+def track_paddle_n(paddle_coeff_n_per_mps2: float, ref_mps: float, u_rel_mps: float,
+                   immersion_share: float) -> float:
+    """Force of a track paddling through the water (its speed relative to the water)."""
+    rel = ref_mps - u_rel_mps
+    return paddle_coeff_n_per_mps2 * rel * abs(rel) * immersion_share
+
+
+def paddle_wrench(paddle_n: list[float], half_sep_m: float) -> Wrench:
+    """Both tracks' paddle forces on the vehicle."""
+    return Wrench(x_n=paddle_n[0] + paddle_n[1],
+                  n_nm=(paddle_n[1] - paddle_n[0]) * half_sep_m)
+
+
+def rolling_resistance(w_eff_n: float, ground_mps: tuple, land: LandParams,
+                       half_sep_m: float) -> list[Wrench]:
+    """Coulomb rolling resistance of each track (regularised), port then starboard."""
+    roll_n = land.rolling_resistance_coeff * w_eff_n / 2.0
+    out = []
+    for i, sign in ((0, -1.0), (1, 1.0)):
+        th = math.tanh(ground_mps[i] / _ROLL_EPS_MPS)
+        f = -roll_n * th
+        dth = roll_n * (1.0 - th * th) / _ROLL_EPS_MPS
+        out.append(Wrench(x_n=f, n_nm=sign * f * half_sep_m, dx_du=-dth,
+                          dn_dr=-(dth * half_sep_m ** 2)))
+    return out
+
+
+def lateral_resistance(w_eff_n: float, sway_mps: float, yaw_rate_rps: float,
+                       points_m: list[float], land: LandParams,
+                       weight_n: float) -> list[Wrench]:
+    """Sideways soil friction and damping at points along the tracks (skid while turning)."""
+    lat_n = land.lateral_friction_coeff * w_eff_n / LATERAL_POINTS
+    v_ref = land.lateral_slip_speed_mps
+    lat_c = land.lateral_damping_n_per_mps * w_eff_n / weight_n / LATERAL_POINTS
+    out = []
+    for s_j in points_m:
+        th = math.tanh((sway_mps + yaw_rate_rps * s_j) / v_ref)
+        f = -lat_n * th - lat_c * (sway_mps + yaw_rate_rps * s_j)
+        d = lat_n * (1.0 - th * th) / v_ref + lat_c
+        out.append(Wrench(y_n=f, n_nm=f * s_j, dy_dv=-d, dn_dr=-(d * s_j * s_j)))
+    return out
+
+
+def slope_gravity(weight_n: float, buoyancy_n: float, gradient: float, cos_yaw: float,
+                  sin_yaw: float) -> list[Wrench]:
+    """Gravity along the slope, (Delta - B) sin(theta) downhill, odom -> body."""
+    if gradient == 0.0:
+        return []
+    down = -(weight_n - buoyancy_n) * gradient / math.sqrt(1.0 + gradient * gradient)
+    return [Wrench(x_n=cos_yaw * down, y_n=-sin_yaw * down)]
+
+
+def propulsion(thrust_n: list[float], walk_ratio: float, prop_x_m: float,
+               half_sep_m: float) -> list[Wrench]:
+    """The two propellers' thrust and the sideways propeller walk."""
+    walk = -walk_ratio * (thrust_n[0] + thrust_n[1])
+    return [Wrench(x_n=thrust_n[0] + thrust_n[1], n_nm=(thrust_n[1] - thrust_n[0]) * half_sep_m),
+            Wrench(y_n=walk, n_nm=walk * prop_x_m)]
+
+
+def hydrodynamic_drag(u_rel_mps: float, v_rel_mps: float, yaw_rate_rps: float,
+                      fraction: float, wat: WaterParams) -> Wrench:
+    """Linear + quadratic hull drag through the water, scaled by the submerged share."""
+    return Wrench(
+        x_n=-(wat.surge_linear_drag_n_per_mps * u_rel_mps
+              + wat.surge_quadratic_drag_n_per_mps2 * abs(u_rel_mps) * u_rel_mps) * fraction,
+        y_n=-(wat.sway_linear_drag_n_per_mps * v_rel_mps
+              + wat.sway_quadratic_drag_n_per_mps2 * abs(v_rel_mps) * v_rel_mps) * fraction,
+        n_nm=-(wat.yaw_linear_drag_nm_per_rps * yaw_rate_rps
+               + wat.yaw_quadratic_drag_nm_per_rps2 * abs(yaw_rate_rps)
+               * yaw_rate_rps) * fraction,
+        dx_du=-(wat.surge_linear_drag_n_per_mps
+                + 2.0 * wat.surge_quadratic_drag_n_per_mps2 * abs(u_rel_mps)) * fraction,
+        dy_dv=-(wat.sway_linear_drag_n_per_mps
+                + 2.0 * wat.sway_quadratic_drag_n_per_mps2 * abs(v_rel_mps)) * fraction,
+        dn_dr=-(wat.yaw_linear_drag_nm_per_rps
+                + 2.0 * wat.yaw_quadratic_drag_nm_per_rps2 * abs(yaw_rate_rps)) * fraction)
+
+
+def odom_force(fx_n: float, fy_n: float, moment_nm: float, cos_yaw: float,
+               sin_yaw: float) -> Wrench:
+    """A horizontal force given in odom (waves, a tow line), in body axes."""
+    return Wrench(x_n=cos_yaw * fx_n + sin_yaw * fy_n, y_n=-sin_yaw * fx_n + cos_yaw * fy_n,
+                  n_nm=moment_nm)

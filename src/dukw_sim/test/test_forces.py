@@ -1,0 +1,92 @@
+"""dukw_sim.forces: the per-effect force terms and their one sum."""
+import math
+
+import pytest
+
+from dukw_sim.core import SimCore
+from dukw_sim.forces import (Wrench, hydrodynamic_drag, lateral_resistance, odom_force,
+                             propulsion, rolling_resistance, slope_gravity, sum_wrenches)
+
+PARAMS = SimCore.from_config().params
+HALF_SEP_M = 0.6
+WEIGHT_N = 2900.0
+
+
+def total(terms: list[Wrench], name: str) -> float:
+    return getattr(sum_wrenches(terms), name)
+
+
+def test_sum_adds_only_the_components_a_term_has():
+    terms = [Wrench(x_n=-0.0, n_nm=2.0), Wrench(y_n=-0.0, n_nm=3.0, dx_du=-4.0),
+             Wrench(x_n=1.5)]
+    forces = sum_wrenches(terms)
+    assert (forces.x_n, forces.y_n, forces.n_nm, forces.dx_du) == (1.5, 0.0, 5.0, -4.0)
+    # a sign of zero survives where no later term has the component
+    assert math.copysign(1.0, sum_wrenches(terms[:2]).x_n) == -1.0
+    # absent components of the first term start at +0.0, as a fresh sum does
+    assert math.copysign(1.0, sum_wrenches(terms[:2]).y_n) == 1.0
+
+
+def test_sum_keeps_the_order_of_the_terms():
+    big, small = 1e16, 1.0
+    forward = sum_wrenches([Wrench(x_n=big), Wrench(x_n=small), Wrench(x_n=small)]).x_n
+    assert forward == (big + small) + small
+    assert forward != big + (small + small)
+
+
+@pytest.mark.parametrize('effect, speed_arg, force, derivative', [
+    (lambda u: [hydrodynamic_drag(u, 0.3, 0.1, 0.8, PARAMS.water)], 'u', 'x_n', 'dx_du'),
+    (lambda v: [hydrodynamic_drag(0.4, v, 0.1, 0.8, PARAMS.water)], 'v', 'y_n', 'dy_dv'),
+    (lambda r: [hydrodynamic_drag(0.4, 0.3, r, 0.8, PARAMS.water)], 'r', 'n_nm', 'dn_dr'),
+    (lambda v: lateral_resistance(1500.0, v, 0.2, [-0.4, 0.0, 0.4], PARAMS.land, WEIGHT_N),
+     'v', 'y_n', 'dy_dv'),
+    (lambda r: lateral_resistance(1500.0, 0.05, r, [-0.4, 0.0, 0.4], PARAMS.land, WEIGHT_N),
+     'r', 'n_nm', 'dn_dr'),
+])
+def test_derivatives_match_the_forces(effect, speed_arg, force, derivative):
+    for speed in (-0.7, -0.02, 0.01, 0.5):
+        step = 1e-6
+        numeric = (total(effect(speed + step), force)
+                   - total(effect(speed - step), force)) / (2.0 * step)
+        assert total(effect(speed), derivative) == pytest.approx(numeric, rel=1e-4, abs=1e-3)
+
+
+def test_rolling_resistance_opposes_motion_and_turning():
+    moving = sum_wrenches(rolling_resistance(2000.0, (0.5, 0.5), PARAMS.land, HALF_SEP_M))
+    assert moving.x_n == pytest.approx(-PARAMS.land.rolling_resistance_coeff * 2000.0)
+    assert moving.n_nm == pytest.approx(0.0)
+    turning = sum_wrenches(rolling_resistance(2000.0, (-0.3, 0.3), PARAMS.land, HALF_SEP_M))
+    assert turning.x_n == pytest.approx(0.0)
+    assert turning.n_nm < 0.0          # turning left (starboard forward) is resisted
+
+
+def test_drag_opposes_the_water_relative_motion_and_vanishes_ashore():
+    drag = hydrodynamic_drag(0.8, -0.2, 0.3, 1.0, PARAMS.water)
+    assert drag.x_n < 0.0 and drag.y_n > 0.0 and drag.n_nm < 0.0
+    ashore = hydrodynamic_drag(0.8, -0.2, 0.3, 0.0, PARAMS.water)
+    assert (ashore.x_n, ashore.y_n, ashore.n_nm) == (0.0, 0.0, 0.0)
+
+
+def test_slope_gravity_pulls_downhill_with_the_unsupported_weight():
+    grad = math.tan(0.1)
+    (facing_sea,) = slope_gravity(WEIGHT_N, 900.0, grad, 1.0, 0.0)
+    assert facing_sea.x_n == pytest.approx(-(WEIGHT_N - 900.0) * math.sin(0.1))
+    (sideways,) = slope_gravity(WEIGHT_N, 900.0, grad, 0.0, 1.0)
+    assert sideways.y_n == pytest.approx((WEIGHT_N - 900.0) * math.sin(0.1))
+    assert slope_gravity(WEIGHT_N, 900.0, 0.0, 1.0, 0.0) == []
+
+
+def test_propulsion_turns_with_differential_thrust_and_walks_sideways():
+    push, walk = propulsion([100.0, 60.0], 0.05, -1.2, HALF_SEP_M)
+    assert push.x_n == 160.0
+    assert push.n_nm == pytest.approx(-40.0 * HALF_SEP_M)
+    assert walk.y_n == pytest.approx(-0.05 * 160.0)
+    assert walk.n_nm == pytest.approx(walk.y_n * -1.2)
+
+
+def test_odom_force_rotates_into_body_axes():
+    yaw = 0.7
+    body = odom_force(10.0, 0.0, 3.0, math.cos(yaw), math.sin(yaw))
+    assert body.x_n == pytest.approx(10.0 * math.cos(yaw))
+    assert body.y_n == pytest.approx(-10.0 * math.sin(yaw))
+    assert body.n_nm == 3.0
