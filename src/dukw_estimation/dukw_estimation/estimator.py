@@ -15,7 +15,7 @@ import numpy as np
 from dukw_common.diagnostics import Health, Level, RateCounter
 from dukw_common.geometry import local_enu_from_geodetic, wrap_angle
 from dukw_common.vehicle import SoilParams, Vehicle
-from dukw_estimation import buoyancy, traction
+from dukw_model import buoyancy, traction
 from dukw_estimation.ekf import (N_STATES, SURFACE_STATES, WATERLINE_STATE, Idx, MotionEkf,
                                  Outcome, ProcessNoise)
 from dukw_estimation.force_filter import ForceSmoother

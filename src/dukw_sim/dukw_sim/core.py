@@ -27,7 +27,7 @@ import numpy as np
 from dukw_common.config import ParamValue, node_params
 from dukw_common.vehicle import SoilParams, Vehicle
 from dukw_driver.motors import prop_thrust_n
-from dukw_estimation import traction
+from dukw_model import traction
 
 from dukw_sim.hull import HullGeometry, Seakeeping
 from dukw_sim.land import TrackContact, linearise, motor_limited_speed

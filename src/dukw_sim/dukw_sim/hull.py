@@ -1,7 +1,7 @@
 """Hull strips: buoyancy, wave forces and the seakeeping constants of the twin-cylinder hull.
 
 Each SWATH hull is a right circular cylinder (vehicle.md section 6) cut into equal
-strips; a strip's immersed section is ``dukw_estimation.buoyancy.HullSection`` under the
+strips; a strip's immersed section is ``dukw_model.buoyancy.HullSection`` under the
 instantaneous water surface (the estimator's section too): the circular segment up to
 the float line, so the hull's volume is ``buoyancy.hull_volume_from_depths`` there. The
 cylinders alone are almost wholly immersed when afloat (0.288 of 0.313 m^3): 4 cm above
@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dukw_common.vehicle import Vehicle
-from dukw_estimation.buoyancy import HullSection
+from dukw_model.buoyancy import HullSection
 
 from dukw_sim.params import SeakeepingParams
 

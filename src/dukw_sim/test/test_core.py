@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from dukw_common.config import ConfigError
-from dukw_estimation.buoyancy import hull_volume_from_depths
+from dukw_model.buoyancy import hull_volume_from_depths
 from dukw_sim.core import Actuation, SimCore, propeller_thrust_factor
 from dukw_sim.truth import Medium, Truth
 
