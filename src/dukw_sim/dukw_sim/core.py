@@ -26,8 +26,8 @@ import numpy as np
 
 from dukw_common.config import ParamValue, node_params
 from dukw_common.vehicle import SoilParams, Vehicle
-from dukw_driver.motors import prop_thrust_n
 from dukw_model import traction
+from dukw_model.propeller import prop_thrust_n, propeller_thrust_factor
 
 from dukw_sim.hull import HullGeometry, Seakeeping
 from dukw_sim.land import TrackContact, linearise, motor_limited_speed
@@ -36,7 +36,7 @@ from dukw_sim.truth import Medium, Truth
 from dukw_sim.world import (Beach, WaveModel, World, irregular_waves, no_waves,
                             regular_waves)
 
-__all__ = ['Actuation', 'SimCore', 'SimParams', 'propeller_thrust_factor']
+__all__ = ['Actuation', 'SimCore', 'SimParams']
 
 _ROLL_EPS_MPS = 0.005          # regularisation of Coulomb rolling resistance
 _FRICTION_EPS_MPS = 0.02       # of drivetrain friction
@@ -80,21 +80,6 @@ class Actuation:
 def _require_finite(what: str, *values: float) -> None:
     if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in values):
         raise ValueError(f'{what} must be finite numbers, got {values}')
-
-
-def propeller_thrust_factor(hub_depth_m: float, diameter_m: float,
-                            ventilation_depth_m: float) -> float:
-    """Share of its open-water thrust a propeller gives at this hub depth, 0..1.
-
-    The thrust follows the part of the propeller disc that works in solid water: the disc
-    below a plane ``ventilation_depth_m`` under the local surface (closer to the surface the
-    blades draw air). A propeller whose tip circle is deeper than that gives full thrust, a
-    half-emerged one about half, one out of the water none. Only the propeller's own depth
-    counts, not the hull's: a pitching hull loses no thrust while its propeller stays under.
-    """
-    radius_m = diameter_m / 2.0
-    h = min(max((hub_depth_m - ventilation_depth_m) / radius_m, -1.0), 1.0)
-    return (math.acos(-h) + h * math.sqrt(1.0 - h * h)) / math.pi
 
 
 def _soil_with_floor(soil: SoilParams, min_k_m: float) -> SoilParams:

@@ -26,7 +26,8 @@ from dukw_common.config import ConfigError, ParamValue, build_settings, node_par
 from dukw_common.geometry import geodetic_from_local_enu, quaternion_from_euler
 from dukw_common.vehicle import (DrivetrainParams, SensorMounts, drivetrain_params,
                                   sensor_mounts)
-from dukw_driver.motors import SideStatus, prop_thrust_n
+from dukw_driver.motors import SideStatus
+from dukw_model.propeller import prop_thrust_n
 from dukw_sim.truth import Truth
 
 NODE_NAME = 'sim_node'
@@ -536,7 +537,7 @@ class SensorModel:
 
     def props(self, truth: Truth) -> DrivetrainReading:
         """The propellers' controller: no encoder (speed 0); thrust estimated from the command
-        as motor_controller_node does (dukw_driver.motors.prop_thrust_n)."""
+        as motor_controller_node does (dukw_model.propeller.prop_thrust_n)."""
         drivetrain = self.config.drivetrain
         return self._drivetrain(
             truth, 'props', (truth.port_prop_cmd_pct, truth.stbd_prop_cmd_pct),

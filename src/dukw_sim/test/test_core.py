@@ -7,7 +7,7 @@ import pytest
 
 from dukw_common.config import ConfigError
 from dukw_model.buoyancy import hull_volume_from_depths
-from dukw_sim.core import Actuation, SimCore, propeller_thrust_factor
+from dukw_sim.core import Actuation, SimCore
 from dukw_sim.truth import Medium, Truth
 
 WAVES = {'waves.model': 'irregular', 'waves.significant_height_m': 0.28}
@@ -163,14 +163,6 @@ def test_start_up_force_peaks_above_the_running_force():
     running = np.mean(forces[-100:])
     assert running > 0.0
     assert max(forces[:100]) > 1.8 * running
-
-
-def test_thrust_factor_follows_the_propeller_disc_in_solid_water():
-    assert propeller_thrust_factor(0.40, 0.25, 0.05) == 1.0
-    assert propeller_thrust_factor(0.05, 0.25, 0.05) == pytest.approx(0.5)
-    assert propeller_thrust_factor(-0.10, 0.25, 0.05) == 0.0
-    shares = [propeller_thrust_factor(d, 0.25, 0.05) for d in np.linspace(-0.07, 0.17, 25)]
-    assert np.all(np.diff(shares) > 0.0)
 
 
 def _thrust_after(pitch_rad: float = 0.0, heave_m: float = 0.0) -> float:
