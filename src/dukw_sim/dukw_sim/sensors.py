@@ -27,6 +27,8 @@ from dukw_common.geometry import geodetic_from_local_enu, quaternion_from_euler
 from dukw_common.vehicle import (DrivetrainParams, SensorMounts, drivetrain_params,
                                   sensor_mounts)
 from dukw_driver.motors import SideStatus
+from dukw_model.lever_arm import (sensor_point_enu, sensor_point_velocity_body,
+                                  specific_force_at_sensor)
 from dukw_model.propeller import prop_thrust_n
 from dukw_sim.truth import Truth
 
@@ -457,10 +459,9 @@ class SensorModel:
         else:
             alpha_x = alpha_y = 0.0
         self._last_rates = (wx, wy, wz)
-        # specific force at r = (0, 0, h): f + alpha x r + w x (w x r)
-        fx = truth.accel_x_mps2 + alpha_y * h + wz * wx * h
-        fy = truth.accel_y_mps2 - alpha_x * h + wz * wy * h
-        fz = truth.accel_z_mps2 - (wx * wx + wy * wy) * h
+        fx, fy, fz = specific_force_at_sensor(
+            (truth.accel_x_mps2, truth.accel_y_mps2, truth.accel_z_mps2), (wx, wy, wz),
+            (alpha_x, alpha_y), h)
         bias, g = self._gyro_bias, noise.gyro_std_rps
         sx, sy, sz = noise.accel_x_std_mps2, noise.accel_y_std_mps2, noise.accel_z_std_mps2
         quat = quaternion_from_euler(truth.roll_rad + err[0], truth.pitch_rad + err[1],
@@ -475,14 +476,9 @@ class SensorModel:
 
     def antenna_enu(self, truth: Truth) -> tuple[float, float, float]:
         """True position of the GPS antenna in odom (ENU), m: base_link + R (0, 0, h)."""
-        h = self.config.mounts.gps_antenna_z_m
-        cr, sr = math.cos(truth.roll_rad), math.sin(truth.roll_rad)
-        cp, sp = math.cos(truth.pitch_rad), math.sin(truth.pitch_rad)
-        cy, sy = math.cos(truth.yaw_rad), math.sin(truth.yaw_rad)
-        # third column of R = Rz(yaw) Ry(pitch) Rx(roll), times h
-        return (truth.x_m + h * (cy * sp * cr + sy * sr),
-                truth.y_m + h * (sy * sp * cr - cy * sr),
-                truth.z_m + h * cp * cr)
+        return sensor_point_enu((truth.x_m, truth.y_m, truth.z_m), truth.roll_rad,
+                                truth.pitch_rad, truth.yaw_rad,
+                                self.config.mounts.gps_antenna_z_m)
 
     def gps_fix(self, truth: Truth) -> GpsFix:
         """DGPS fix of the antenna from the configured datum, with slowly drifting error."""
@@ -501,8 +497,8 @@ class SensorModel:
         """DGPS velocity of the antenna, ENU: body velocity plus w x r, rotated; white noise."""
         s, h = self.config.noise.gps_velocity_std_mps, self.config.mounts.gps_antenna_z_m
         d = self._noise['gps_vel'].draw()
-        u = truth.surge_mps + truth.pitch_rate_rps * h
-        v = truth.sway_mps - truth.roll_rate_rps * h
+        u, v = sensor_point_velocity_body(truth.surge_mps, truth.sway_mps,
+                                          truth.roll_rate_rps, truth.pitch_rate_rps, h)
         cy, sy = math.cos(truth.yaw_rad), math.sin(truth.yaw_rad)
         return GpsVelocity(truth.t_s, (cy * u - sy * v + s * d[0], sy * u + cy * v + s * d[1],
                                        truth.heave_mps + s * d[2]), (s * s, s * s, s * s))
