@@ -16,6 +16,7 @@ from dukw_common.diagnostics import Health, Level, RateCounter
 from dukw_common.geometry import local_enu_from_geodetic, wrap_angle
 from dukw_common.vehicle import SoilParams, Vehicle
 from dukw_model import buoyancy, traction
+from dukw_model.seakeeping import heave_constants
 from dukw_model.lever_arm import (base_from_sensor_point, lever_arm_enu,
                                   sensor_point_velocity_body, specific_force_at_base)
 from dukw_estimation.ekf import (N_STATES, SURFACE_STATES, WATERLINE_STATE, Idx, MotionEkf,
@@ -53,14 +54,10 @@ class Estimator:
         # the IMU says
         self.sure_float_m3 = 0.5 * (body.displaced_volume_m3 + self.max_volume_m3)
         self.track_area_m2 = body.track_width_m * body.track_contact_length_m
-        # the heave stiffness of the hulls' section about the float line (as the simulator's)
-        waterplane_m2 = 2.0 * self.section.heave_width_m() * body.hull_length_m
-        self.heave_mass_kg = buoyancy.heave_mass_kg(waterplane_m2,
-                                                    body.water_density_kgpm3,
-                                                    body.gravity_mps2, settings.heave_natural_hz)
-        stiffness = body.water_density_kgpm3 * body.gravity_mps2 * waterplane_m2
-        self.heave_damping_n_per_mps = 2.0 * settings.heave_damping_ratio * math.sqrt(
-            stiffness * self.heave_mass_kg)
+        # the heave mass and damping of the hulls' section about the float line (the simulator's)
+        heave = heave_constants(body, settings.heave_natural_hz, settings.heave_damping_ratio)
+        self.heave_mass_kg = heave.mass_kg
+        self.heave_damping_n_per_mps = heave.damping_n_per_mps
         self.counters: dict[str, dict[Outcome, int]] = {s: defaultdict(int) for s in SENSORS}
         self.rates = {s: RateCounter() for s in SENSORS}
         self.reset()

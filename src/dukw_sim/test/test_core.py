@@ -7,6 +7,7 @@ import pytest
 
 from dukw_common.config import ConfigError
 from dukw_model.buoyancy import hull_volume_from_depths
+from dukw_model.seakeeping import heave_constants
 from dukw_sim.core import Actuation, SimCore
 from dukw_sim.truth import Medium, Truth
 
@@ -286,13 +287,15 @@ def test_truth_contact_weight_and_forces_agree_through_the_surf():
     assert grazed > 0          # the run does graze the sand on a track end
 
 
-def test_estimator_heave_mass_and_damping_are_the_simulators():
-    """One hull model: the estimator's afloat volume from the heave acceleration uses the
-    heave mass the simulator's hull is calibrated to (it used the bare 0.89 m^2 waterplane,
-    9 % lighter)."""
-    from dukw_estimation.evaluate import build_estimator
+def test_hull_heave_mass_and_damping_are_the_shared_models():
+    """One hull model: the simulator's heave mass and damping are dukw_model.seakeeping's,
+    which the estimator's afloat volume from the heave acceleration uses too (it once used
+    the bare 0.89 m^2 waterplane, 9 % lighter)."""
     sim = SimCore.from_config()
-    est = build_estimator(sim.vehicle, (0.0, 0.0, 0.0))
-    assert est.heave_mass_kg == pytest.approx(sim.seakeeping.heave_mass_kg, rel=1e-9)
-    assert est.heave_damping_n_per_mps == pytest.approx(
-        sim.seakeeping.heave_damping_n_per_mps, rel=1e-9)
+    facts = sim.params.seakeeping
+    heave = heave_constants(sim.vehicle.body, facts.heave_natural_hz, facts.heave_damping_ratio)
+    assert sim.seakeeping.heave_mass_kg == pytest.approx(heave.mass_kg, rel=1e-9)
+    assert sim.seakeeping.heave_damping_n_per_mps == pytest.approx(heave.damping_n_per_mps,
+                                                                   rel=1e-9)
+    assert heave.mass_kg > sim.vehicle.body.mass_kg     # added mass
+
