@@ -37,8 +37,6 @@ TARGETS = {'position_rmse_m': 0.5, 'heading_rmse_deg': 3.0, 'slip_rmse': 0.05,
            'volume_error_pct': 10.0, 'fraction_error': 0.1}
 WARM_UP_S = 2.0                # scored from here: the filter has had a fix and a heading
 MOVING_TRACK_MPS = 0.1         # slip is scored only where the track turns
-SEA_TO_LAND_CLEARANCE_M = 0.30  # vehicle.md 6: floating with the treads 30 cm above the sand
-LAND_CLEARANCE_M = 20.0        # the land circle runs this far landward of the slope
 
 
 @dataclass(frozen=True)
@@ -138,14 +136,7 @@ def run_scenario(scenario: Scenario, duration_s: float = 30.0, seed: int = 0,
                               seed=seed)
     sensors = SensorModel.from_config(config, seed=seed)
     vehicle = sim.vehicle
-    if scenario.start == 'flat':
-        sim.reset(x_m=sim.params.world.flat_start_x_m - LAND_CLEARANCE_M,
-                  yaw_rad=scenario.yaw_rad)
-    elif scenario.start == 'sea':
-        depth = vehicle.body.draft_m + SEA_TO_LAND_CLEARANCE_M
-        sim.reset(x_m=depth / math.tan(vehicle.site.beach_slope_rad), yaw_rad=scenario.yaw_rad)
-    else:
-        sim.reset(scenario.start, yaw_rad=scenario.yaw_rad)
+    sim.reset(scenario.start, yaw_rad=scenario.yaw_rad)     # SimCore.start_x_m
     gps = sensors.config.gps
     est = build_estimator(vehicle, (gps.datum_lat_deg, gps.datum_lon_deg, gps.datum_alt_m),
                           config)

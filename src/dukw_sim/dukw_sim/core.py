@@ -159,15 +159,27 @@ class SimCore:
         return cls(Vehicle.from_params(params), SimParams.from_params(params), seed)
 
     # ----------------------------------------------------------------- reset / helpers
+    def start_x_m(self, start: str) -> float:
+        """Where a named start is along the beach, m (``start.*``; the one definition the
+        maneuvers, the evaluation and the campaigns use): 'sand', 'surf', 'afloat'; 'flat'
+        (flat sand clear of the slope) and 'sea' (just afloat off the slope)."""
+        st = self.params.start
+        if start == 'flat':
+            return self.params.world.flat_start_x_m - st.land_clearance_m
+        if start == 'sea':
+            depth_m = self.vehicle.body.draft_m + st.sea_tread_clearance_m
+            return depth_m / math.tan(self.vehicle.site.beach_slope_rad)
+        starts = {'sand': st.sand_x_m, 'surf': st.surf_x_m, 'afloat': st.afloat_x_m}
+        if start not in starts:
+            raise ValueError(f'start must be one of {sorted([*starts, "flat", "sea"])}, '
+                             f'got {start!r}')
+        return starts[start]
+
     def reset(self, start: str = 'sand', x_m: float | None = None,
               yaw_rad: float = 0.0) -> Truth:
-        """Put the vehicle at rest at a configured start ('sand', 'surf', 'afloat') or at x_m."""
-        starts = {'sand': self.params.start.sand_x_m, 'surf': self.params.start.surf_x_m,
-                  'afloat': self.params.start.afloat_x_m}
+        """Put the vehicle at rest at a named start (``start_x_m``) or at x_m."""
         if x_m is None:
-            if start not in starts:
-                raise ValueError(f'start must be one of {sorted(starts)}, got {start!r}')
-            x_m = starts[start]
+            x_m = self.start_x_m(start)
         _require_finite('reset position and yaw', x_m, yaw_rad)
         self.t_s = 0.0
         self.x, self.y, self.yaw = float(x_m), 0.0, float(yaw_rad)
