@@ -71,13 +71,13 @@ class ClosedLoop:
             from dukw_estimation.evaluate import SensorAdapter, build_estimator
             from dukw_sim.sensors import SensorModel
             self.sensors = SensorModel.from_config(seed=seed)
-            gps = self.sensors.config.gps
+            gps = self.sensors.config.datum
             vehicle = self.sim.vehicle
             if not estimator_knows_site:
                 from dukw_common.vehicle import Vehicle
                 vehicle = Vehicle.from_params(node_params('ekf_node'))
-            self.est = build_estimator(vehicle, (gps.datum_lat_deg, gps.datum_lon_deg,
-                                                 gps.datum_alt_m))
+            self.est = build_estimator(vehicle, (gps.latitude_deg, gps.longitude_deg,
+                                                 gps.altitude_m))
             self.adapter = SensorAdapter(self.est)
         self.sensor_filter = sensor_filter
         self.estimate = None

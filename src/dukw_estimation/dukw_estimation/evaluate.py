@@ -137,8 +137,8 @@ def run_scenario(scenario: Scenario, duration_s: float = 30.0, seed: int = 0,
     sensors = SensorModel.from_config(config, seed=seed)
     vehicle = sim.vehicle
     sim.reset(scenario.start, yaw_rad=scenario.yaw_rad)     # SimCore.start_x_m
-    gps = sensors.config.gps
-    est = build_estimator(vehicle, (gps.datum_lat_deg, gps.datum_lon_deg, gps.datum_alt_m),
+    gps = sensors.config.datum
+    est = build_estimator(vehicle, (gps.latitude_deg, gps.longitude_deg, gps.altitude_m),
                           config)
     adapter = SensorAdapter(est)
     act = Actuation(*scenario.tracks_pct, *scenario.props_pct)

@@ -154,12 +154,12 @@ class SensorNoise:
 
 
 @dataclass(frozen=True)
-class GpsSettings:
-    """Geodetic datum of the odom origin (config ``gps.*``)."""
+class DatumSettings:
+    """Geodetic datum of the odom origin (the shared ``datum.*``)."""
 
-    datum_lat_deg: float
-    datum_lon_deg: float
-    datum_alt_m: float
+    latitude_deg: float
+    longitude_deg: float
+    altitude_m: float
 
 
 @dataclass(frozen=True)
@@ -206,7 +206,7 @@ class MotorSettings:
 
 
 #: Fields that may be negative (everything else is a non-negative quantity).
-_SIGNED = {'datum_lat_deg', 'datum_lon_deg', 'datum_alt_m', 'offset_m', 'water_temp_c',
+_SIGNED = {'latitude_deg', 'longitude_deg', 'altitude_m', 'offset_m', 'water_temp_c',
            'ambient_temp_c', 'overheat_c'}
 
 
@@ -226,7 +226,7 @@ class SensorConfig:
 
     rates: SensorRates
     noise: SensorNoise
-    gps: GpsSettings
+    datum: DatumSettings
     water: WaterSettings
     depth: DepthSettings
     battery: BatterySettings
@@ -240,7 +240,7 @@ class SensorConfig:
         rates = SensorRates(**{f'{s}_hz': _positive(params, f'rates.{s}_hz')
                                for s in SENSOR_STREAMS})
         return cls(rates, _group(SensorNoise, params, 'noise'),
-                   _group(GpsSettings, params, 'gps'),
+                   _group(DatumSettings, params, 'datum'),
                    _group(WaterSettings, params, 'water_contact'),
                    _group(DepthSettings, params, 'depth'),
                    _group(BatterySettings, params, 'battery'),
@@ -482,14 +482,14 @@ class SensorModel:
 
     def gps_fix(self, truth: Truth) -> GpsFix:
         """DGPS fix of the antenna from the configured datum, with slowly drifting error."""
-        noise, gps = self.config.noise, self.config.gps
+        noise, datum = self.config.noise, self.config.datum
         dt = self._dt('gps_fix', truth.t_s)
         d = self._noise['gps_fix'].draw()
         east, north, up = self.antenna_enu(truth)
         err = [g.step(dt, d[k]) for k, g in enumerate(self._gps_error)]
         lat, lon, alt = geodetic_from_local_enu(east + err[0], north + err[1], up + err[2],
-                                                gps.datum_lat_deg, gps.datum_lon_deg,
-                                                gps.datum_alt_m)
+                                                datum.latitude_deg, datum.longitude_deg,
+                                                datum.altitude_m)
         h2, v2 = noise.gps_horizontal_std_m ** 2, noise.gps_vertical_std_m ** 2
         return GpsFix(truth.t_s, lat, lon, alt, (h2, h2, v2))
 
