@@ -26,7 +26,8 @@ PARAMS = [
     ParamSpec('poll_rate_hz', 'radio read / telemetry tick rate, Hz', min=5.0, max=500.0),
     ParamSpec('reconnect_period_s', 'reopen a failed link after, s', min=0.05, max=60.0),
     ParamSpec('diagnostics_period_s', '/diagnostics period, s', min=0.1, max=60.0),
-    ParamSpec('current_limit_a', 'continuous motor current (trk_i_pct), A', min=1.0, max=500.0),
+    ParamSpec('drivetrain.continuous_current_limit_a', 'continuous motor current (the shared '
+              'drivetrain fact; trk_i_pct), A', min=1.0, max=500.0),
     ParamSpec('mission_speed_mps', 'leg speed before any DO_CHANGE_SPEED, m/s', min=0.05,
               max=2.0),
     *(ParamSpec(f'datum.{n}', f'odom origin {n} (the shared datum.*)', min=lo, max=hi)
