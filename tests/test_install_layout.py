@@ -16,7 +16,7 @@ NODES = {
 WORKSPACE = Path(__file__).resolve().parents[1]
 
 
-@pytest.mark.parametrize('package', [*NODES, 'dukw_msgs', 'dukw_common'])
+@pytest.mark.parametrize('package', [*NODES, 'dukw_msgs', 'dukw_common', 'dukw_model'])
 def test_package_in_ament_index_of_the_merged_install(package):
     prefix = Path(get_package_prefix(package))
     assert prefix == WORKSPACE / 'install'

@@ -42,8 +42,6 @@ BOUNDS = {'significant_wave_height_m': (0.0, 1.0), 'peak_period_s': (1.0, 20.0),
           'sensor_seed': (0, 2 ** 32 - 1), 'yaw_rate_rps': (-1.5, 1.5)}
 FAULTS = {'gps_dropout': ('start_s', 'duration_s'), 'gps_outlier': ('start_s', 'offset_m')}
 TARGET_NAMES = ('slip_rmse', 'volume_error_pct', 'fraction_error', 'mode_delay_s')
-LAND_CLEARANCE_M = 20.0        # the land circle runs this far landward of the slope
-SEA_TO_LAND_CLEARANCE_M = 0.30  # vehicle.md 6: floating with the treads 30 cm above the sand
 EARTH_RADIUS_M = 6_371_000.0
 MOVING_TRACK_MPS = 0.1          # slip is scored only where the track turns (as evaluate)
 
@@ -308,18 +306,9 @@ def build_loop(spec: Spec, cond: Mapping[str, Any]):
         loop.est.soil = loop.sim.vehicle.soil
     loop.sensors.seed = cond['sensor_seed']
     loop.sensors.reset()
-    start = loop.sim.params.start
-    if cond['kind'] == 'land_to_sea':
-        x_m, yaw = start.sand_x_m + cond['start_offset_m'], 0.0
-    elif cond['kind'] == 'land_circle':
-        x_m = loop.sim.params.world.flat_start_x_m - LAND_CLEARANCE_M + cond['start_offset_m']
-        yaw = 0.0
-    elif cond['kind'] == 'water_circle':
-        x_m, yaw = start.afloat_x_m + cond['start_offset_m'], 0.0
-    else:
-        depth = loop.sim.vehicle.body.draft_m + SEA_TO_LAND_CLEARANCE_M
-        x_m = depth / math.tan(math.radians(cond['beach_slope_deg'])) + cond['start_offset_m']
-        yaw = math.pi
+    start, yaw = {'land_to_sea': ('sand', 0.0), 'land_circle': ('flat', 0.0),
+                  'water_circle': ('afloat', 0.0)}.get(cond['kind'], ('sea', math.pi))
+    x_m = loop.sim.start_x_m(start) + cond['start_offset_m']     # (the slope: site.*, above)
     loop.truth = loop.sim.reset(x_m=x_m, yaw_rad=yaw)
     return loop
 

@@ -35,8 +35,6 @@ TARGETS = {'position_rmse_m': 0.5, 'heading_rmse_deg': 3.0, 'slip_rmse': 0.05,
            'volume_error_pct': 10.0, 'fraction_error': 0.1}
 WARM_UP_S = 2.0                # scored from here: the filter has had a fix and a heading
 MOVING_TRACK_MPS = 0.1         # slip is scored only where the track turns
-SEA_TO_LAND_CLEARANCE_M = 0.30  # vehicle.md 6: floating with the treads 30 cm above the sand
-LAND_CLEARANCE_M = 20.0        # the land circle runs this far landward of the slope
 
 
 @dataclass(frozen=True)
@@ -71,19 +69,6 @@ def _wave_overrides(height_m: float) -> dict:
     return {'waves.model': 'irregular', 'waves.significant_height_m': height_m}
 
 
-def _place(stack: ClosedLoop, scenario: Scenario) -> None:
-    sim = stack.sim
-    vehicle = sim.vehicle
-    if scenario.start == 'flat':
-        stack.place(x_m=sim.params.world.flat_start_x_m - LAND_CLEARANCE_M,
-                    yaw_rad=scenario.yaw_rad)
-    elif scenario.start == 'sea':
-        depth = vehicle.body.draft_m + SEA_TO_LAND_CLEARANCE_M
-        stack.place(x_m=depth / math.tan(vehicle.site.beach_slope_rad), yaw_rad=scenario.yaw_rad)
-    else:
-        stack.place(scenario.start, yaw_rad=scenario.yaw_rad)
-
-
 def run_scenario(scenario: Scenario, duration_s: float = 30.0, seed: int = 0,
                  config: str | None = None, oracle_surface: bool = False) -> dict:
     """Run one scenario on the in-process stack with fixed actuation; its metrics.
@@ -94,7 +79,7 @@ def run_scenario(scenario: Scenario, duration_s: float = 30.0, seed: int = 0,
     act = Actuation(*scenario.tracks_pct, *scenario.props_pct)
     stack = ClosedLoop(_wave_overrides(scenario.wave_height_m), seed=seed, feedback='ekf',
                        config=config, actuation=act)
-    _place(stack, scenario)
+    stack.place(scenario.start, yaw_rad=scenario.yaw_rad)     # SimCore.start_x_m
     est = stack.est
     if oracle_surface:
         def pin(topic: str, t_ns: int, item) -> None:

@@ -13,7 +13,8 @@ temperature ``?T`` (the channel's heat sink), faults ``?FF`` + ``?FM``. Tracks:
 speed from the motor RPM through the reduction and the drive sprocket, force =
 current x gain (8.16 N/A, vehicle.md section 3). Propellers: no encoder, speed
 0; force is a thrust estimate from the applied command, linear up to the rated
-133 N forward and the reverse share backwards (the simulator's model).
+133 N forward and the reverse share backwards (``dukw_model.propeller``, the
+simulator's model too).
 """
 from __future__ import annotations
 
@@ -23,6 +24,7 @@ from enum import Enum
 from dukw_common.config import ConfigError
 from dukw_common.readings import MotorSide
 from dukw_common.vehicle import DrivetrainParams
+from dukw_model.propeller import prop_thrust_n
 from dukw_driver.roboteq import (CONFIG_QUERIES, FAULT_COMM_TIMEOUT, QUERIES, ReplyParser,
                                  config_frame, decode_faults, decode_status, query_frame)
 
@@ -47,12 +49,6 @@ def track_speed_mps(motor_rpm: float, drivetrain: DrivetrainParams) -> float:
     """Track belt speed from the motor's RPM: through the reduction to the drive sprocket."""
     sprocket_rps = motor_rpm / drivetrain.gear_reduction / 60.0
     return sprocket_rps * math.pi * drivetrain.sprocket_diameter_m
-
-
-def prop_thrust_n(command_pct: float, drivetrain: DrivetrainParams) -> float:
-    """Propeller thrust estimate from the applied command, N (reverse weaker)."""
-    ratio = 1.0 if command_pct >= 0 else drivetrain.prop_reverse_thrust_ratio
-    return drivetrain.max_prop_thrust_n * ratio * command_pct / 100.0
 
 
 #: A channel the controller does not answer for (one motor channel: readings.MotorSide).

@@ -517,7 +517,8 @@ STREAMS = tuple(STREAM_IDS)
 def settings_from_params(p: dict) -> tuple[ShoreSettings, Tuning]:
     """ShoreSettings and Tuning from the node's parameters (config/dukw.yaml shore_link_node)."""
     datum = Datum(p['datum.latitude_deg'], p['datum.longitude_deg'], p['datum.altitude_m'])
-    settings = ShoreSettings(datum, p['current_limit_a'], p['mission_speed_mps'],
+    settings = ShoreSettings(datum, p['drivetrain.continuous_current_limit_a'],
+                             p['mission_speed_mps'],
                              int(p['radio_baud']), p['radio_budget_fraction'],
                              int(p['system_id']), int(p['component_id']))
     try:

@@ -26,10 +26,11 @@ PARAMS = [
     ParamSpec('poll_rate_hz', 'radio read / telemetry tick rate, Hz', min=5.0, max=500.0),
     ParamSpec('reconnect_period_s', 'reopen a failed link after, s', min=0.05, max=60.0),
     ParamSpec('diagnostics_period_s', '/diagnostics period, s', min=0.1, max=60.0),
-    ParamSpec('current_limit_a', 'continuous motor current (trk_i_pct), A', min=1.0, max=500.0),
+    ParamSpec('drivetrain.continuous_current_limit_a', 'continuous motor current (the shared '
+              'drivetrain fact; trk_i_pct), A', min=1.0, max=500.0),
     ParamSpec('mission_speed_mps', 'leg speed before any DO_CHANGE_SPEED, m/s', min=0.05,
               max=2.0),
-    *(ParamSpec(f'datum.{n}', f'odom origin {n} (= ekf_node datum)', min=lo, max=hi)
+    *(ParamSpec(f'datum.{n}', f'odom origin {n} (the shared datum.*)', min=lo, max=hi)
       for n, lo, hi in (('latitude_deg', -90.0, 90.0), ('longitude_deg', -180.0, 180.0),
                         ('altitude_m', -1000.0, 10000.0))),
     ParamSpec('manual.max_speed_mps', 'cmd_vel at MANUAL_CONTROL x=1000, m/s', min=0.0, max=2.0),

@@ -8,7 +8,8 @@ from hypothesis import strategies as st
 from dukw_common.config import ConfigError
 from dukw_common.vehicle import Vehicle
 from dukw_driver import roboteq
-from dukw_driver.motors import Drive, MotorMonitor, prop_thrust_n, track_speed_mps
+from dukw_driver.motors import Drive, MotorMonitor, track_speed_mps
+from dukw_model.propeller import prop_thrust_n
 from dukw_driver.roboteq import ReplyParser, decode_faults, decode_status, query_frame
 from fake_roboteq import FakeRoboteq
 

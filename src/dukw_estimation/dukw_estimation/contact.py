@@ -14,7 +14,8 @@ import math
 import numpy as np
 
 from dukw_common.vehicle import SoilParams, Vehicle
-from dukw_estimation import buoyancy, traction
+from dukw_model import buoyancy, traction
+from dukw_model.seakeeping import heave_constants
 from dukw_estimation.ekf import Idx
 from dukw_estimation.force_filter import ForceSmoother
 from dukw_common.readings import DriveStatus, ImuSample
@@ -50,14 +51,10 @@ class ContactModel:
         # the IMU says
         self.sure_float_m3 = 0.5 * (body.displaced_volume_m3 + self.max_volume_m3)
         self.track_area_m2 = body.track_width_m * body.track_contact_length_m
-        # the heave stiffness of the hulls' section about the float line (as the simulator's)
-        waterplane_m2 = 2.0 * self.section.heave_width_m() * body.hull_length_m
-        self.heave_mass_kg = buoyancy.heave_mass_kg(waterplane_m2,
-                                                    body.water_density_kgpm3,
-                                                    body.gravity_mps2, settings.heave_natural_hz)
-        stiffness = body.water_density_kgpm3 * body.gravity_mps2 * waterplane_m2
-        self.heave_damping_n_per_mps = 2.0 * settings.heave_damping_ratio * math.sqrt(
-            stiffness * self.heave_mass_kg)
+        # the heave mass and damping of the hulls' section about the float line (the simulator's)
+        heave = heave_constants(body, settings.heave_natural_hz, settings.heave_damping_ratio)
+        self.heave_mass_kg = heave.mass_kg
+        self.heave_damping_n_per_mps = heave.damping_n_per_mps
         self.reset()
 
     def reset(self) -> None:

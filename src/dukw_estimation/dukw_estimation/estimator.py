@@ -22,7 +22,7 @@ from dukw_common.diagnostics import Health, Level, RateCounter
 from dukw_common.vehicle import SoilParams, Vehicle
 from dukw_common.readings import (DepthReading, DriveStatus, GpsFix, GpsVelocity, ImuSample,
                                   WaterContact)
-from dukw_estimation import traction
+from dukw_model import traction
 from dukw_estimation.contact import ContactModel, ground_speeds
 from dukw_estimation.ekf import Idx, MotionEkf, Outcome
 from dukw_estimation.motion_filter import GROUNDED_FRACTION, MotionFilter

@@ -25,7 +25,7 @@ from scipy.optimize import least_squares
 
 from dukw_common.config import ConfigError
 from dukw_common.vehicle import SoilParams, Vehicle
-from dukw_estimation import traction
+from dukw_model import traction
 
 TRACTION_TYPE = 'dukw_msgs/msg/Traction'
 MIN_SAMPLES = 20

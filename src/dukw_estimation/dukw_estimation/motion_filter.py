@@ -15,6 +15,8 @@ import numpy as np
 
 from dukw_common.geometry import local_enu_from_geodetic, wrap_angle
 from dukw_common.vehicle import Vehicle
+from dukw_model.lever_arm import (base_from_sensor_point, lever_arm_enu,
+                                  sensor_point_velocity_body, specific_force_at_base)
 from dukw_estimation.ekf import N_STATES, Idx, MotionEkf, Outcome, ProcessNoise
 from dukw_common.readings import DriveStatus, GpsFix, GpsVelocity, ImuSample
 from dukw_estimation.samples import OdometryEstimate
@@ -180,20 +182,18 @@ class MotionFilter:
             alpha_y = (s.pitch_rate_rps - prev.pitch_rate_rps) / dt
         else:
             alpha_x = alpha_y = 0.0
-        wx, wy, wz = s.roll_rate_rps, s.pitch_rate_rps, s.yaw_rate_rps
-        return (s.accel_x_mps2 - (alpha_y + wz * wx) * h,
-                s.accel_y_mps2 + (alpha_x - wz * wy) * h,
-                s.accel_z_mps2 + (wx * wx + wy * wy) * h)
+        return specific_force_at_base((s.accel_x_mps2, s.accel_y_mps2, s.accel_z_mps2),
+                                      (s.roll_rate_rps, s.pitch_rate_rps, s.yaw_rate_rps),
+                                      (alpha_x, alpha_y), h)
 
 
-    def _lever_arm(self) -> tuple[float, float, float, float]:
-        """Antenna offset terms: (a, b, p, q) with a = h sin(pitch) cos(roll), b = h sin(roll)."""
-        h = self.vehicle.sensors.gps_antenna_z_m
+    def _mast_attitude(self) -> tuple[float, float, float, float]:
+        """(roll, pitch, roll rate, pitch rate) of the last IMU sample for the antenna's lever
+        arm (level and still without one)."""
         imu = self.imu
         if imu is None:
             return 0.0, 0.0, 0.0, 0.0
-        return (h * math.sin(imu.pitch_rad) * math.cos(imu.roll_rad), h * math.sin(imu.roll_rad),
-                imu.roll_rate_rps, imu.pitch_rate_rps)
+        return imu.roll_rad, imu.pitch_rad, imu.roll_rate_rps, imu.pitch_rate_rps
 
 
     # ------------------------------------------------------------------ DGPS
@@ -204,13 +204,14 @@ class MotionFilter:
         east, north, _ = local_enu_from_geodetic(s.latitude_deg, s.longitude_deg, s.altitude_m,
                                                  *self.datum)
         x = self.ekf.x
-        a, b, _, _ = self._lever_arm()
-        c, sn = math.cos(x[Idx.YAW]), math.sin(x[Idx.YAW])
-        offset = np.array([c * a + sn * b, sn * a - c * b])
+        roll, pitch, _, _ = self._mast_attitude()
+        h = self.vehicle.sensors.gps_antenna_z_m
+        offset = np.array(lever_arm_enu(roll, pitch, x[Idx.YAW], h)[:2])
         var = s.horizontal_var_m2 if s.horizontal_var_m2 > 0 and self.settings.gps_bias_sigma_m \
             == 0.0 else self.settings.gps_position_m ** 2
         if not self.position_set:      # the first fix: start there, as sure as the fix is
-            x[Idx.X], x[Idx.Y] = east - offset[0], north - offset[1]
+            x[Idx.X], x[Idx.Y], _ = base_from_sensor_point((east, north, 0.0), roll, pitch,
+                                                            x[Idx.YAW], h)
             for i in (Idx.X, Idx.Y):
                 self.ekf.P[i, :] = 0.0
                 self.ekf.P[:, i] = 0.0
@@ -219,8 +220,7 @@ class MotionFilter:
             self.position_set = True
         H = np.zeros((2, N_STATES))
         H[0, Idx.X] = H[1, Idx.Y] = H[0, Idx.GPS_BIAS_E] = H[1, Idx.GPS_BIAS_N] = 1.0
-        H[0, Idx.YAW] = -sn * a + c * b
-        H[1, Idx.YAW] = c * a + sn * b
+        H[0, Idx.YAW], H[1, Idx.YAW] = -offset[1], offset[0]    # d(offset)/d(yaw)
         # (with bias states the message's covariance, the total error, is not the white part)
         predicted = x[[Idx.X, Idx.Y]] + offset + x[[Idx.GPS_BIAS_E, Idx.GPS_BIAS_N]]
         return self.ekf.update(np.array([east, north]), predicted, H, np.eye(2) * var,
@@ -230,8 +230,8 @@ class MotionFilter:
         """DGPS ground velocity of the antenna (ENU); corrects u, v and yaw."""
         x = self.ekf.x
         h = self.vehicle.sensors.gps_antenna_z_m
-        _, _, p, q = self._lever_arm()
-        ub, vb = x[Idx.U] + q * h, x[Idx.V] - p * h
+        _, _, p, q = self._mast_attitude()
+        ub, vb = sensor_point_velocity_body(x[Idx.U], x[Idx.V], p, q, h)
         c, sn = math.cos(x[Idx.YAW]), math.sin(x[Idx.YAW])
         H = np.zeros((2, N_STATES))
         H[0, Idx.U], H[0, Idx.V], H[0, Idx.YAW] = c, -sn, -sn * ub - c * vb

@@ -97,11 +97,11 @@ class EkfSettings:
     wave_damping_ratio: float = _f('wave.damping_ratio', 'oscillator damping (sea bandwidth)',
                                    0.01, 2)
     wave_sigma_m: float = _f('wave.sigma_m', 'wave elevation sigma, ~ H1/3 / 4', 0, 2)
-    heave_natural_hz: float = _f('heave.natural_frequency_hz',
+    heave_natural_hz: float = _f('seakeeping.heave_natural_hz',
                                  'heave natural frequency afloat (vehicle.md 5: 0.5731)', 0.01, 10)
-    heave_damping_ratio: float = _f('heave.damping_ratio', 'heave damping ratio afloat (the '
-                                    'damping force joins the heave acceleration in the '
-                                    'afloat volume)', 0, 2)
+    heave_damping_ratio: float = _f('seakeeping.heave_damping_ratio',
+                                    'heave damping ratio afloat (the damping force joins the '
+                                    'heave acceleration in the afloat volume)', 0, 2)
     heave_velocity_tau_s: float = _f('heave.velocity_time_constant_s', 'heave velocity: '
                                      'leaky integral of the (mean-removed) heave '
                                      'acceleration', 0.1, 100)

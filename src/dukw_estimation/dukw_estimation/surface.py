@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from dukw_common.vehicle import Vehicle
-from dukw_estimation import traction
+from dukw_model import traction
 from dukw_estimation.contact import ContactModel, ground_speeds
 from dukw_estimation.ekf import N_STATES, SURFACE_STATES, WATERLINE_STATE, Idx, MotionEkf, Outcome
 from dukw_common.readings import DepthReading, DriveStatus, WaterContact

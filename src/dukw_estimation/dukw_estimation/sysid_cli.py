@@ -23,7 +23,8 @@ import numpy as np
 import yaml
 
 from dukw_estimation import sysid
-from dukw_estimation.sysid import Model, SysIdError
+from dukw_model import state_space
+from dukw_model.state_space import Model, SysIdError
 from dukw_estimation.sysid_io import read_run
 
 PAPER_MODELS_FILE = Path('reference') / 'paper_models.yaml'
@@ -47,7 +48,7 @@ def _fmt_fit(fit: dict[str, float] | None) -> str:
 
 
 def load_runs(paths: Sequence[str], medium: str, truth: bool, dt_s: float,
-              min_duration_s: float) -> list[sysid.Run]:
+              min_duration_s: float) -> list[state_space.Run]:
     """Read, resample and check every run (SysIdError on the first bad one)."""
     runs = []
     for path in paths:
@@ -71,7 +72,7 @@ def save_model(model: Model, path: str) -> None:
     Path(path).write_text(yaml.safe_dump(model.to_dict(), sort_keys=False, width=100))
 
 
-def _report_runs(comparisons: Sequence[sysid.Comparison]) -> list[dict[str, Any]]:
+def _report_runs(comparisons: Sequence[state_space.Comparison]) -> list[dict[str, Any]]:
     out = []
     for comp in comparisons:
         print(f'{comp.run.name}: {comp.run.duration_s:.1f} s')
@@ -92,7 +93,7 @@ def cmd_identify(args: argparse.Namespace) -> dict[str, Any]:
     print(f'suggested order: {result.suggested_order} (largest drop); using {model.order}')
     print(f'operating point: commands {np.round(model.u_offset, 2).tolist()} %, '
           f'u v r {np.round(model.y_offset, 4).tolist()}')
-    comparisons = [sysid.compare(model, run) for run in runs]
+    comparisons = [state_space.compare(model, run) for run in runs]
     per_run = _report_runs(comparisons)
     if args.out:
         save_model(model, args.out)
@@ -105,9 +106,9 @@ def cmd_identify(args: argparse.Namespace) -> dict[str, Any]:
         plots.append(str(plot_singular_values(sv[:20], args.plots, model.order)))
     return {'command': 'identify', 'medium': model.medium, 'order': model.order,
             'dt_s': model.dt_s, 'fit_pct': model.fit_pct,
-            'one_step_fit_pct': sysid.pooled_fit(comparisons, one_step=True),
+            'one_step_fit_pct': state_space.pooled_fit(comparisons, one_step=True),
             'singular_values': sv[:12].tolist(), 'suggested_order': result.suggested_order,
-            'poles': [p['abs'] for p in sysid.describe_poles(model)], 'runs': per_run,
+            'poles': [p['abs'] for p in state_space.describe_poles(model)], 'runs': per_run,
             'model': args.out, 'plots': plots}
 
 
@@ -115,12 +116,12 @@ def cmd_validate(args: argparse.Namespace) -> dict[str, Any]:
     """Simulate the model on each run; fits per output, pooled over the runs."""
     model = load_model(args.model)
     runs = load_runs(args.runs, model.medium, args.truth, model.dt_s, args.min_duration)
-    models = [sysid.with_offsets_of(model, r) if args.detrend else model for r in runs]
-    comparisons = [sysid.compare(m, r) for m, r in zip(models, runs, strict=True)]
+    models = [state_space.with_offsets_of(model, r) if args.detrend else model for r in runs]
+    comparisons = [state_space.compare(m, r) for m, r in zip(models, runs, strict=True)]
     print(f'{model.medium} model, order {model.order}, operating point: '
           + ("each run's own means (--detrend)" if args.detrend else "the model's"))
     per_run = _report_runs(comparisons)
-    fit, one_step = sysid.pooled_fit(comparisons), sysid.pooled_fit(comparisons, True)
+    fit, one_step = state_space.pooled_fit(comparisons), state_space.pooled_fit(comparisons, True)
     print(f'all runs: simulated fit {_fmt_fit(fit)}')
     plots = []
     if args.plots:
@@ -146,14 +147,14 @@ def _paper_reference(path: str | None) -> dict:
 
 
 def _print_model(title: str, model: Model) -> dict[str, Any]:
-    poles = sysid.describe_poles(model)
+    poles = state_space.describe_poles(model)
     gain = model.dc_gain()
     print(f'{title}')
     for p in poles:
         print(f'  pole {p["re"]:+.5f}{p["im"]:+.5f}j  |p| {p["abs"]:.5f}  '
               f'tau {p["time_constant_s"]:.3g} s')
     print('  steady-state gain per % (port, stbd):')
-    for name, row in zip(sysid.OUTPUTS, gain, strict=True):
+    for name, row in zip(state_space.OUTPUTS, gain, strict=True):
         print(f'    {name}: {row[0]:+.3e} {row[1]:+.3e}')
     return {'poles': poles, 'dc_gain_per_pct': gain.tolist()}
 
@@ -161,7 +162,7 @@ def _print_model(title: str, model: Model) -> dict[str, Any]:
 def cmd_compare_paper(args: argparse.Namespace) -> dict[str, Any]:
     """Poles and steady-state gains beside the paper's; both models' fits on the runs."""
     model = load_model(args.model)
-    paper = sysid.paper_model(_paper_reference(args.reference), model.medium)
+    paper = state_space.paper_model(_paper_reference(args.reference), model.medium)
     print('paper outputs converted to REP 103: v and r sign-flipped (the paper has y to '
           'starboard and a negative yaw rate in a port turn)')
     ours = _print_model(f'identified {model.medium} model (order {model.order})', model)
@@ -173,8 +174,8 @@ def cmd_compare_paper(args: argparse.Namespace) -> dict[str, Any]:
         print("fits on the runs, each model about each run's own means (the paper's "
               'operating point is not published):')
         for key, base in (('fit_pct', model), ('paper_fit_pct', paper)):
-            comps = [sysid.compare(sysid.with_offsets_of(base, r), r) for r in runs]
-            out[key] = sysid.pooled_fit(comps)
+            comps = [state_space.compare(state_space.with_offsets_of(base, r), r) for r in runs]
+            out[key] = state_space.pooled_fit(comps)
             print(f'  {"identified" if base is model else "paper":<10} {_fmt_fit(out[key])}')
     return out
 
@@ -190,10 +191,10 @@ def build_parser() -> argparse.ArgumentParser:
                         help='refuse shorter runs, s (default %(default)s)')
     sub = parser.add_subparsers(dest='command', required=True)
     p = sub.add_parser('identify', parents=[common], help='fit a model (N4SID)')
-    p.add_argument('--medium', choices=sysid.MEDIA, required=True)
-    p.add_argument('--order', type=int, default=sysid.PAPER_ORDER,
+    p.add_argument('--medium', choices=state_space.MEDIA, required=True)
+    p.add_argument('--order', type=int, default=state_space.PAPER_ORDER,
                    help='model order (default %(default)s, as the paper)')
-    p.add_argument('--dt', type=float, default=sysid.PAPER_DT_S,
+    p.add_argument('--dt', type=float, default=state_space.PAPER_DT_S,
                    help='resampling period, s (default %(default)s, as the paper)')
     p.add_argument('--block-rows', type=int, default=sysid.DEFAULT_BLOCK_ROWS,
                    help='Hankel block rows (default %(default)s)')

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from dukw_estimation.sysid import SysIdError, Run
+from dukw_model.state_space import Run, SysIdError
 
 #: Command topic per medium.
 COMMAND_TOPIC = {'land': 'tracks/cmd', 'water': 'props/cmd'}

@@ -5,7 +5,7 @@ import re
 from pathlib import Path
 from typing import Sequence
 
-from dukw_estimation.sysid import OUTPUTS, Comparison
+from dukw_model.state_space import OUTPUTS, Comparison
 
 _LABELS = {'u': 'surge u, m/s', 'v': 'sway v, m/s', 'r': 'yaw rate r, rad/s'}
 

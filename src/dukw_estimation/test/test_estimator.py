@@ -9,7 +9,7 @@ from dukw_common.config import ConfigError, node_params
 from dukw_common.diagnostics import Level
 from dukw_common.geometry import geodetic_from_local_enu
 from dukw_common.vehicle import Vehicle, soil_params
-from dukw_estimation import traction
+from dukw_model import traction
 from dukw_estimation.ekf import Idx, Outcome
 from dukw_estimation.estimator import Estimator
 from dukw_estimation.force_filter import ForceSmoother
@@ -275,7 +275,7 @@ def test_lying_still_in_a_trough_is_on_the_sand_though_the_mean_surface_would_fl
 def _surf_run(est, true_surface_m, slip_, seconds=5.0, x0=5.0, track_mps=0.5):
     """Crawl seaward on the slope with both tracks slipping by slip_, under a surface
     true_surface_m off the mean; the track forces are the Wong forces of the true weight."""
-    from dukw_estimation import buoyancy
+    from dukw_model import buoyancy
     slope = VEHICLE.site.beach_slope_rad
     body, drive = VEHICLE.body, VEHICLE.drivetrain
     section = buoyancy.HullSection.of_body(body)

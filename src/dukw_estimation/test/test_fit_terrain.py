@@ -7,7 +7,8 @@ import pytest
 from rosbags.rosbag2 import Writer
 
 from dukw_common.vehicle import SoilParams, Vehicle
-from dukw_estimation import fit_terrain, traction
+from dukw_estimation import fit_terrain
+from dukw_model import traction
 
 VEHICLE = Vehicle.load()
 BODY = VEHICLE.body

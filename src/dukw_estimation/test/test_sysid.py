@@ -6,6 +6,7 @@ import pytest
 import yaml
 
 from dukw_estimation import sysid
+from dukw_model import state_space
 from dukw_estimation.sysid_cli import load_model, main, save_model
 from dukw_estimation.sysid_io import read_run
 from dukw_sim import maneuver
@@ -17,7 +18,7 @@ TRUE_B = np.array([[0.02, 0.01], [0.0, 0.05], [0.03, -0.03]])
 TRUE_C = np.array([[1.0, 0.5, 0.0], [0.0, 1.0, 0.3], [0.2, 0.0, 1.0]])
 
 
-def _known_run(seed: int, n: int = 3000, noise: float = 0.01) -> sysid.Run:
+def _known_run(seed: int, n: int = 3000, noise: float = 0.01) -> state_space.Run:
     """The known third-order system driven by random held steps, output noise added."""
     rng = np.random.default_rng(seed)
     u = np.repeat(rng.uniform(-50.0, 50.0, size=(n // 50, 2)), 50, axis=0)
@@ -26,7 +27,7 @@ def _known_run(seed: int, n: int = 3000, noise: float = 0.01) -> sysid.Run:
         y[k] = TRUE_C @ x
         x = TRUE_A @ x + TRUE_B @ u[k]
     y += noise * np.std(y, axis=0) * rng.standard_normal(y.shape)
-    return sysid.Run(f'known-{seed}', 'land', 0.01 * np.arange(n), u, y)
+    return state_space.Run(f'known-{seed}', 'land', 0.01 * np.arange(n), u, y)
 
 
 def test_known_third_order_system_poles_and_validation_fit():
@@ -35,15 +36,15 @@ def test_known_third_order_system_poles_and_validation_fit():
     true = np.sort(np.diag(TRUE_A))
     assert np.all(np.abs(found - true) / true < 0.05), (found, true)
     assert result.suggested_order == 3
-    check = sysid.compare(result.model, _known_run(2))
+    check = state_space.compare(result.model, _known_run(2))
     assert min(check.fit_pct.values()) >= 90.0, check.fit_pct
     assert min(check.one_step_fit_pct.values()) >= 90.0
 
 
 def test_fit_is_matlab_compare_formula():
     y = np.array([[0.0, 1.0, 2.0], [2.0, 3.0, 2.0], [4.0, 5.0, 8.0]])
-    assert sysid.fit_pct(y, y) == {'u': 100.0, 'v': 100.0, 'r': 100.0}
-    flat = sysid.fit_pct(y, np.tile(y.mean(axis=0), (3, 1)))
+    assert state_space.fit_pct(y, y) == {'u': 100.0, 'v': 100.0, 'r': 100.0}
+    flat = state_space.fit_pct(y, np.tile(y.mean(axis=0), (3, 1)))
     assert flat == pytest.approx({'u': 0.0, 'v': 0.0, 'r': 0.0})
 
 
@@ -218,7 +219,7 @@ def test_model_file_round_trips(tmp_path):
     assert back.medium == 'land' and back.dt_s == model.dt_s and back.fit_pct == model.fit_pct
     # what the file says the equations are, with numpy alone
     u = np.full((400, 2), 10.0) + data['u_offset']
-    np.testing.assert_allclose(sysid.simulate(back, u), sysid.simulate(model, u))
+    np.testing.assert_allclose(state_space.simulate(back, u), state_space.simulate(model, u))
 
 
 def _paper_pairs():

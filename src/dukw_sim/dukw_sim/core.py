@@ -26,8 +26,8 @@ import numpy as np
 
 from dukw_common.config import ParamValue, node_params
 from dukw_common.vehicle import SoilParams, Vehicle
-from dukw_driver.motors import prop_thrust_n
-from dukw_estimation import traction
+from dukw_model import traction
+from dukw_model.propeller import prop_thrust_n, propeller_thrust_factor
 
 from dukw_sim.forces import (LATERAL_POINTS, BodyForces, Immersion, WaveForcing,
                              drivetrain_friction_n, hydrodynamic_drag, immersion,
@@ -41,7 +41,7 @@ from dukw_sim.truth import Medium, Truth
 from dukw_sim.world import (Beach, WaveModel, World, irregular_waves, no_waves,
                             regular_waves)
 
-__all__ = ['Actuation', 'SimCore', 'SimParams', 'propeller_thrust_factor']
+__all__ = ['Actuation', 'SimCore', 'SimParams']
 
 _LAND_FRACTION = 0.02          # submerged share of the afloat volume below which: LAND
 _NEWTON_PASSES = 3             # implicit track-soil solve
@@ -105,21 +105,6 @@ class Actuation:
 def _require_finite(what: str, *values: float) -> None:
     if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in values):
         raise ValueError(f'{what} must be finite numbers, got {values}')
-
-
-def propeller_thrust_factor(hub_depth_m: float, diameter_m: float,
-                            ventilation_depth_m: float) -> float:
-    """Share of its open-water thrust a propeller gives at this hub depth, 0..1.
-
-    The thrust follows the part of the propeller disc that works in solid water: the disc
-    below a plane ``ventilation_depth_m`` under the local surface (closer to the surface the
-    blades draw air). A propeller whose tip circle is deeper than that gives full thrust, a
-    half-emerged one about half, one out of the water none. Only the propeller's own depth
-    counts, not the hull's: a pitching hull loses no thrust while its propeller stays under.
-    """
-    radius_m = diameter_m / 2.0
-    h = min(max((hub_depth_m - ventilation_depth_m) / radius_m, -1.0), 1.0)
-    return (math.acos(-h) + h * math.sqrt(1.0 - h * h)) / math.pi
 
 
 def _soil_with_floor(soil: SoilParams, min_k_m: float) -> SoilParams:
@@ -200,15 +185,27 @@ class SimCore:
         return cls(Vehicle.from_params(params), SimParams.from_params(params), seed)
 
     # ----------------------------------------------------------------- reset / helpers
+    def start_x_m(self, start: str) -> float:
+        """Where a named start is along the beach, m (``start.*``; the one definition the
+        maneuvers, the evaluation and the campaigns use): 'sand', 'surf', 'afloat'; 'flat'
+        (flat sand clear of the slope) and 'sea' (just afloat off the slope)."""
+        st = self.params.start
+        if start == 'flat':
+            return self.params.world.flat_start_x_m - st.land_clearance_m
+        if start == 'sea':
+            depth_m = self.vehicle.body.draft_m + st.sea_tread_clearance_m
+            return depth_m / math.tan(self.vehicle.site.beach_slope_rad)
+        starts = {'sand': st.sand_x_m, 'surf': st.surf_x_m, 'afloat': st.afloat_x_m}
+        if start not in starts:
+            raise ValueError(f'start must be one of {sorted([*starts, "flat", "sea"])}, '
+                             f'got {start!r}')
+        return starts[start]
+
     def reset(self, start: str = 'sand', x_m: float | None = None,
               yaw_rad: float = 0.0) -> Truth:
-        """Put the vehicle at rest at a configured start ('sand', 'surf', 'afloat') or at x_m."""
-        starts = {'sand': self.params.start.sand_x_m, 'surf': self.params.start.surf_x_m,
-                  'afloat': self.params.start.afloat_x_m}
+        """Put the vehicle at rest at a named start (``start_x_m``) or at x_m."""
         if x_m is None:
-            if start not in starts:
-                raise ValueError(f'start must be one of {sorted(starts)}, got {start!r}')
-            x_m = starts[start]
+            x_m = self.start_x_m(start)
         _require_finite('reset position and yaw', x_m, yaw_rad)
         self.t_s = 0.0
         self.x, self.y, self.yaw = float(x_m), 0.0, float(yaw_rad)

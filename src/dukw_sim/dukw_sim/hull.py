@@ -1,7 +1,7 @@
 """Hull strips: buoyancy, wave forces and the seakeeping constants of the twin-cylinder hull.
 
 Each SWATH hull is a right circular cylinder (vehicle.md section 6) cut into equal
-strips; a strip's immersed section is ``dukw_estimation.buoyancy.HullSection`` under the
+strips; a strip's immersed section is ``dukw_model.buoyancy.HullSection`` under the
 instantaneous water surface (the estimator's section too): the circular segment up to
 the float line, so the hull's volume is ``buoyancy.hull_volume_from_depths`` there. The
 cylinders alone are almost wholly immersed when afloat (0.288 of 0.313 m^3): 4 cm above
@@ -17,18 +17,15 @@ so the roll inertia absorbs the difference.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from dukw_common.vehicle import Vehicle
-from dukw_estimation.buoyancy import HullSection
+from dukw_model.buoyancy import HullSection
+from dukw_model.seakeeping import HEAVE_SECANT_M, heave_constants, oscillator_constants
 
 from dukw_sim.params import SeakeepingParams
-
-_SECANT_M = 0.02          # heave amplitude the linearised stiffness is taken over
-
 
 @dataclass(frozen=True)
 class HullGeometry:
@@ -101,18 +98,15 @@ class Seakeeping:
                   params: SeakeepingParams) -> 'Seakeeping':
         """Inertias from the strip stiffness at the float line and the measured frequencies."""
         body = vehicle.body
-        rho_g = body.water_density_kgpm3 * body.gravity_mps2
-        # the waterplane is the strut's above the float line, the cylinder's (widening
-        # downwards) below it: HullSection.heave_width_m (the estimator's heave mass too)
-        strip = rho_g * hull.section.heave_width_m(_SECANT_M) * hull.strip_length_m
-        k_heave = strip * hull.station_x_m.size
+        heave = heave_constants(body, params.heave_natural_hz, params.heave_damping_ratio)
+        # roll and pitch: the heave waterplane's strips times their lever arm squared
+        strip = body.water_density_kgpm3 * body.gravity_mps2 * hull.section.heave_width_m(
+            HEAVE_SECANT_M) * hull.strip_length_m
         k_roll = strip * float(np.sum(hull.station_y_m ** 2))
         k_pitch = strip * float(np.sum(hull.station_x_m ** 2))
-        out = []
-        for k, hz, zeta in ((k_heave, params.heave_natural_hz, params.heave_damping_ratio),
-                            (k_roll, params.roll_natural_hz, params.roll_damping_ratio),
-                            (k_pitch, params.pitch_natural_hz, params.pitch_damping_ratio)):
-            inertia = k / (2.0 * math.pi * hz) ** 2
-            out.append((inertia, 2.0 * zeta * math.sqrt(k * inertia)))
+        out = [(heave.mass_kg, heave.damping_n_per_mps),
+               oscillator_constants(k_roll, params.roll_natural_hz, params.roll_damping_ratio),
+               oscillator_constants(k_pitch, params.pitch_natural_hz, params.pitch_damping_ratio)]
         (m3, c3), (i4, c4), (i5, c5) = out
-        return cls(m3, i4, i5, c3, c4, c5, k_heave, k_roll, k_pitch, hull.float_depth_m)
+        return cls(m3, i4, i5, c3, c4, c5, heave.stiffness_n_per_m, k_roll, k_pitch,
+                   hull.float_depth_m)

@@ -3,7 +3,7 @@
 Each track's controller holds a commanded track speed (100 % = full scale) through a
 speed loop; the motor force it may apply is limited by the controller's current limit
 (force = gain x (current - no-load current), vehicle.md section 3). The soil answers
-with the modified Wong tractive force of ``dukw_estimation.traction`` for the track's
+with the modified Wong tractive force of ``dukw_model.traction`` for the track's
 slip and its share of the effective weight. When the force the soil would take at the
 commanded speed exceeds what the motor can give, the track slows until the two balance
 (the stall on 19 deg: "without track slip" on firm sand).
@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from dukw_common.vehicle import SoilParams
-from dukw_estimation import traction
+from dukw_model import traction
 
 _GRID = np.linspace(0.0, 1.0, 41)
 _PROBE_MPS = 1e-3          # ground-speed step for the force derivative

@@ -52,10 +52,8 @@ CSV_COLUMNS: list[tuple[str, Callable[[Truth], float]]] = [
     ('medium', lambda t: int(t.medium)),
 ]
 
-_LAND_CLEARANCE_M = 20.0     # land manoeuvres start this far landward of the slope
 _INCLINE_LENGTH_M = 60.0     # incline runs: a slope this long (horizontal) above the water
 _INCLINE_START_X_M = -10.0   # and start on it this far landward of the waterline
-_SEA_TO_LAND_CLEARANCE_M = 0.30   # section 6: floating with the treads 30 cm above the sand
 _TETHER_STIFFNESS_N_PER_M = 60.0  # drift: a person loosely holding the vehicle (assumed)
 _TETHER_DAMPING_N_PER_MPS = 60.0
 
@@ -110,10 +108,6 @@ def _props(port: float, stbd: float) -> Actuation:
     return Actuation(port_prop_pct=port, stbd_prop_pct=stbd)
 
 
-def _land_start_x(sim: SimCore) -> float:
-    return sim.params.world.flat_start_x_m - _LAND_CLEARANCE_M
-
-
 def _mean(values: np.ndarray) -> float:
     return float(np.mean(values)) if values.size else float('nan')
 
@@ -127,7 +121,7 @@ def circle(medium: str, port: float, stbd: float, duration_s: float = 30.0, seed
     """Constant commands on flat sand (tracks) or afloat (propellers); fit the circle."""
     sim = SimCore.from_config(config, seed=seed)
     if medium == 'land':
-        sim.reset(x_m=_land_start_x(sim))
+        sim.reset('flat')
         act = _tracks(port, stbd)
     else:
         sim.reset('afloat')
@@ -164,7 +158,7 @@ def zigzag(medium: str, high: float, low: float, period_s: float = 10.0,
     sim = SimCore.from_config(config, seed=seed)
     land = medium == 'land'
     if land:
-        sim.reset(x_m=_land_start_x(sim))
+        sim.reset('flat')
     else:
         sim.reset('afloat')
     make = _tracks if land else _props
@@ -244,8 +238,7 @@ def transition(direction: str, command: float, wave_height_m: float = 0.0,
     if direction == 'land-to-sea':
         sim.reset('sand')
     else:
-        depth = sim.vehicle.body.draft_m + _SEA_TO_LAND_CLEARANCE_M
-        sim.reset(x_m=depth / math.tan(sim.vehicle.site.beach_slope_rad), yaw_rad=math.pi)
+        sim.reset('sea', yaw_rad=math.pi)
     run = Run('transition')
     _drive(sim, run, duration_s, lambda t: _tracks(command, command))
     media = [t.medium for t in run.rows]

@@ -152,6 +152,8 @@ class StartParams:
     sand_x_m: float
     surf_x_m: float
     afloat_x_m: float
+    land_clearance_m: float       # 'flat': this far landward of world.flat_start_x_m
+    sea_tread_clearance_m: float  # 'sea': floating, the treads this high over the slope
 
 
 @dataclass(frozen=True)

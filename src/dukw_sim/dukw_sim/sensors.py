@@ -29,7 +29,9 @@ from dukw_common.readings import (DepthReading, DriveStatus, GpsFix, GpsVelocity
                                   MotorSide, WaterContact)
 from dukw_common.vehicle import (DrivetrainParams, SensorMounts, drivetrain_params,
                                   sensor_mounts)
-from dukw_driver.motors import prop_thrust_n
+from dukw_model.lever_arm import (sensor_point_enu, sensor_point_velocity_body,
+                                  specific_force_at_sensor)
+from dukw_model.propeller import prop_thrust_n
 from dukw_sim.truth import Truth
 
 NODE_NAME = 'sim_node'
@@ -88,12 +90,12 @@ class SensorNoise:
 
 
 @dataclass(frozen=True)
-class GpsSettings:
-    """Geodetic datum of the odom origin (config ``gps.*``)."""
+class DatumSettings:
+    """Geodetic datum of the odom origin (the shared ``datum.*``)."""
 
-    datum_lat_deg: float
-    datum_lon_deg: float
-    datum_alt_m: float
+    latitude_deg: float
+    longitude_deg: float
+    altitude_m: float
 
 
 @dataclass(frozen=True)
@@ -140,7 +142,7 @@ class MotorSettings:
 
 
 #: Fields that may be negative (everything else is a non-negative quantity).
-_SIGNED = {'datum_lat_deg', 'datum_lon_deg', 'datum_alt_m', 'offset_m', 'water_temp_c',
+_SIGNED = {'latitude_deg', 'longitude_deg', 'altitude_m', 'offset_m', 'water_temp_c',
            'ambient_temp_c', 'overheat_c'}
 
 
@@ -160,7 +162,7 @@ class SensorConfig:
 
     rates: SensorRates
     noise: SensorNoise
-    gps: GpsSettings
+    datum: DatumSettings
     water: WaterSettings
     depth: DepthSettings
     battery: BatterySettings
@@ -174,7 +176,7 @@ class SensorConfig:
         rates = SensorRates(**{f'{s}_hz': _positive(params, f'rates.{s}_hz')
                                for s in SENSOR_STREAMS})
         return cls(rates, _group(SensorNoise, params, 'noise'),
-                   _group(GpsSettings, params, 'gps'),
+                   _group(DatumSettings, params, 'datum'),
                    _group(WaterSettings, params, 'water_contact'),
                    _group(DepthSettings, params, 'depth'),
                    _group(BatterySettings, params, 'battery'),
@@ -393,10 +395,9 @@ class SensorModel:
         else:
             alpha_x = alpha_y = 0.0
         self._last_rates = (wx, wy, wz)
-        # specific force at r = (0, 0, h): f + alpha x r + w x (w x r)
-        fx = truth.accel_x_mps2 + alpha_y * h + wz * wx * h
-        fy = truth.accel_y_mps2 - alpha_x * h + wz * wy * h
-        fz = truth.accel_z_mps2 - (wx * wx + wy * wy) * h
+        fx, fy, fz = specific_force_at_sensor(
+            (truth.accel_x_mps2, truth.accel_y_mps2, truth.accel_z_mps2), (wx, wy, wz),
+            (alpha_x, alpha_y), h)
         bias, g = self._gyro_bias, noise.gyro_std_rps
         sx, sy, sz = noise.accel_x_std_mps2, noise.accel_y_std_mps2, noise.accel_z_std_mps2
         att2, head2 = noise.attitude_std_rad ** 2, noise.heading_std_rad ** 2
@@ -410,25 +411,20 @@ class SensorModel:
 
     def antenna_enu(self, truth: Truth) -> tuple[float, float, float]:
         """True position of the GPS antenna in odom (ENU), m: base_link + R (0, 0, h)."""
-        h = self.config.mounts.gps_antenna_z_m
-        cr, sr = math.cos(truth.roll_rad), math.sin(truth.roll_rad)
-        cp, sp = math.cos(truth.pitch_rad), math.sin(truth.pitch_rad)
-        cy, sy = math.cos(truth.yaw_rad), math.sin(truth.yaw_rad)
-        # third column of R = Rz(yaw) Ry(pitch) Rx(roll), times h
-        return (truth.x_m + h * (cy * sp * cr + sy * sr),
-                truth.y_m + h * (sy * sp * cr - cy * sr),
-                truth.z_m + h * cp * cr)
+        return sensor_point_enu((truth.x_m, truth.y_m, truth.z_m), truth.roll_rad,
+                                truth.pitch_rad, truth.yaw_rad,
+                                self.config.mounts.gps_antenna_z_m)
 
     def gps_fix(self, truth: Truth) -> GpsFix:
         """DGPS fix of the antenna from the configured datum, with slowly drifting error."""
-        noise, gps = self.config.noise, self.config.gps
+        noise, datum = self.config.noise, self.config.datum
         dt = self._dt('gps_fix', truth.t_s)
         d = self._noise['gps_fix'].draw()
         east, north, up = self.antenna_enu(truth)
         err = [g.step(dt, d[k]) for k, g in enumerate(self._gps_error)]
         lat, lon, alt = geodetic_from_local_enu(east + err[0], north + err[1], up + err[2],
-                                                gps.datum_lat_deg, gps.datum_lon_deg,
-                                                gps.datum_alt_m)
+                                                datum.latitude_deg, datum.longitude_deg,
+                                                datum.altitude_m)
         h2, v2 = noise.gps_horizontal_std_m ** 2, noise.gps_vertical_std_m ** 2
         return GpsFix(truth.t_s, lat, lon, alt, horizontal_var_m2=h2, valid=True,
                       vertical_var_m2=v2)
@@ -437,8 +433,8 @@ class SensorModel:
         """DGPS velocity of the antenna, ENU: body velocity plus w x r, rotated; white noise."""
         s, h = self.config.noise.gps_velocity_std_mps, self.config.mounts.gps_antenna_z_m
         d = self._noise['gps_vel'].draw()
-        u = truth.surge_mps + truth.pitch_rate_rps * h
-        v = truth.sway_mps - truth.roll_rate_rps * h
+        u, v = sensor_point_velocity_body(truth.surge_mps, truth.sway_mps,
+                                          truth.roll_rate_rps, truth.pitch_rate_rps, h)
         cy, sy = math.cos(truth.yaw_rad), math.sin(truth.yaw_rad)
         return GpsVelocity(truth.t_s, cy * u - sy * v + s * d[0], sy * u + cy * v + s * d[1],
                            var_mps2=s * s, up_mps=truth.heave_mps + s * d[2], up_var_mps2=s * s)
@@ -474,7 +470,7 @@ class SensorModel:
 
     def props(self, truth: Truth) -> DriveStatus:
         """The propellers' controller: no encoder (speed 0); thrust estimated from the command
-        as motor_controller_node does (dukw_driver.motors.prop_thrust_n)."""
+        as motor_controller_node does (dukw_model.propeller.prop_thrust_n)."""
         drivetrain = self.config.drivetrain
         return self._drivetrain(
             truth, 'props', (truth.port_prop_cmd_pct, truth.stbd_prop_cmd_pct),

@@ -39,6 +39,10 @@ _OWN = [
       for s in (*SENSOR_STREAMS, *NODE_STREAMS)],
     *[ParamSpec(f'noise.{n}', f'sensor noise: {n}', min=0.0)
       for n in SensorNoise.__dataclass_fields__],
+    *[ParamSpec(f'datum.{n}', f'odom origin {n} (the shared datum.*): the GPS fixes', min=lo,
+                max=hi) for n, lo, hi in (('latitude_deg', -90.0, 90.0),
+                                          ('longitude_deg', -180.0, 180.0),
+                                          ('altitude_m', -1000.0, 10000.0))],
 ]
 
 

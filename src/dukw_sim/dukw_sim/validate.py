@@ -23,7 +23,7 @@ import numpy as np
 import yaml
 
 from dukw_common.config import ConfigError, default_config_path
-from dukw_estimation import sysid
+from dukw_model import state_space
 from dukw_sim import maneuver
 from dukw_sim.core import Actuation, SimCore
 from dukw_sim.truth import Medium
@@ -221,7 +221,7 @@ _RUNNERS: dict[str, Callable] = {
 
 # ---------------------------------------------------------------------------- zigzags
 def zigzag_run(medium: str, high: float, low: float, ref: dict, seed: int,
-               config: str | None) -> sysid.Run:
+               config: str | None) -> state_space.Run:
     """A simulated zigzag as a system-identification run (commands %, u v r REP 103)."""
     rows = maneuver.zigzag(medium, high, low, ref['period_s'], ref['duration_s'], seed,
                            config).rows
@@ -230,7 +230,7 @@ def zigzag_run(medium: str, high: float, low: float, ref: dict, seed: int,
     else:
         cmds = [[t.port_prop_cmd_pct, t.stbd_prop_cmd_pct] for t in rows]
     y = [[t.surge_mps, t.sway_mps, t.yaw_rate_rps] for t in rows]
-    return sysid.Run(f'{medium} {high:g}/{low:g}', medium, np.array([t.t_s for t in rows]),
+    return state_space.Run(f'{medium} {high:g}/{low:g}', medium, np.array([t.t_s for t in rows]),
                      np.array(cmds, dtype=float), np.array(y, dtype=float))
 
 
@@ -238,12 +238,12 @@ def zigzag_fits(ref: dict, res: Results, seed: int, config: str | None,
                 paper_models: dict) -> None:
     """The paper's identified models (REP 103 outputs, about each run's own means: their
     operating point is not published) against the simulator's zigzags, fit % of u, v, r
-    as MATLAB's compare gives it (dukw_estimation.sysid)."""
+    as MATLAB's compare gives it (dukw_model.state_space)."""
     for medium in ('land', 'water'):
         high, low = ref[medium]
         run = zigzag_run(medium, high, low, ref, seed, config)
-        model = sysid.with_offsets_of(sysid.paper_model(paper_models, medium), run)
-        comparison = sysid.compare(model, run)
+        model = state_space.with_offsets_of(state_space.paper_model(paper_models, medium), run)
+        comparison = state_space.compare(model, run)
         res.fits[run.name] = comparison.fit_pct
         res.series[f'zigzag_{medium}'] = (run.t_s, run.y, comparison.y_sim)
 

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from dukw_common.config import ConfigError
-from dukw_estimation.buoyancy import hull_volume_from_depths
-from dukw_sim.core import Actuation, SimCore, propeller_thrust_factor
+from dukw_model.buoyancy import hull_volume_from_depths
+from dukw_model.seakeeping import heave_constants
+from dukw_sim.core import Actuation, SimCore
 from dukw_sim.truth import Medium, Truth
 
 WAVES = {'waves.model': 'irregular', 'waves.significant_height_m': 0.28}
@@ -165,14 +166,6 @@ def test_start_up_force_peaks_above_the_running_force():
     assert max(forces[:100]) > 1.8 * running
 
 
-def test_thrust_factor_follows_the_propeller_disc_in_solid_water():
-    assert propeller_thrust_factor(0.40, 0.25, 0.05) == 1.0
-    assert propeller_thrust_factor(0.05, 0.25, 0.05) == pytest.approx(0.5)
-    assert propeller_thrust_factor(-0.10, 0.25, 0.05) == 0.0
-    shares = [propeller_thrust_factor(d, 0.25, 0.05) for d in np.linspace(-0.07, 0.17, 25)]
-    assert np.all(np.diff(shares) > 0.0)
-
-
 def _thrust_after(pitch_rad: float = 0.0, heave_m: float = 0.0) -> float:
     sim = SimCore.from_config()
     sim.reset('afloat')
@@ -294,13 +287,15 @@ def test_truth_contact_weight_and_forces_agree_through_the_surf():
     assert grazed > 0          # the run does graze the sand on a track end
 
 
-def test_estimator_heave_mass_and_damping_are_the_simulators():
-    """One hull model: the estimator's afloat volume from the heave acceleration uses the
-    heave mass the simulator's hull is calibrated to (it used the bare 0.89 m^2 waterplane,
-    9 % lighter)."""
-    from dukw_estimation.evaluate import build_estimator
+def test_hull_heave_mass_and_damping_are_the_shared_models():
+    """One hull model: the simulator's heave mass and damping are dukw_model.seakeeping's,
+    which the estimator's afloat volume from the heave acceleration uses too (it once used
+    the bare 0.89 m^2 waterplane, 9 % lighter)."""
     sim = SimCore.from_config()
-    est = build_estimator(sim.vehicle, (0.0, 0.0, 0.0))
-    assert est.heave_mass_kg == pytest.approx(sim.seakeeping.heave_mass_kg, rel=1e-9)
-    assert est.heave_damping_n_per_mps == pytest.approx(
-        sim.seakeeping.heave_damping_n_per_mps, rel=1e-9)
+    facts = sim.params.seakeeping
+    heave = heave_constants(sim.vehicle.body, facts.heave_natural_hz, facts.heave_damping_ratio)
+    assert sim.seakeeping.heave_mass_kg == pytest.approx(heave.mass_kg, rel=1e-9)
+    assert sim.seakeeping.heave_damping_n_per_mps == pytest.approx(heave.damping_n_per_mps,
+                                                                   rel=1e-9)
+    assert heave.mass_kg > sim.vehicle.body.mass_kg     # added mass
+

@@ -119,8 +119,8 @@ def test_imu_above_base_link_feels_lever_arm_accelerations():
 def gps_enu(fix):
     p = PARAMS
     return local_enu_from_geodetic(fix.latitude_deg, fix.longitude_deg, fix.altitude_m,
-                                   p['gps.datum_lat_deg'], p['gps.datum_lon_deg'],
-                                   p['gps.datum_alt_m'])
+                                   p['datum.latitude_deg'], p['datum.longitude_deg'],
+                                   p['datum.altitude_m'])
 
 
 def test_gps_fix_is_the_antenna_from_the_datum():
@@ -128,7 +128,7 @@ def test_gps_fix_is_the_antenna_from_the_datum():
     m = quiet_model()
     fix = m.gps_fix(Truth(x_m=100.0, y_m=-20.0, z_m=0.3))
     assert gps_enu(fix) == pytest.approx((100.0, -20.0, 0.3 + h), abs=1e-6)
-    assert fix.longitude_deg > PARAMS['gps.datum_lon_deg']   # x is east
+    assert fix.longitude_deg > PARAMS['datum.longitude_deg']   # x is east
     # pitch nose down (REP 103 positive) moves the antenna forward; roll to starboard... left
     fix = m.gps_fix(Truth(pitch_rad=0.1, yaw_rad=math.pi / 2))
     assert gps_enu(fix)[:2] == pytest.approx((0.0, h * math.sin(0.1)), abs=1e-6)
@@ -235,8 +235,8 @@ def test_bad_config_is_refused_naming_the_parameter(name, value):
 
 
 def test_missing_parameter_is_named():
-    params = {k: v for k, v in PARAMS.items() if k != 'gps.datum_lat_deg'}
-    with pytest.raises(ConfigError, match='gps.datum_lat_deg'):
+    params = {k: v for k, v in PARAMS.items() if k != 'datum.latitude_deg'}
+    with pytest.raises(ConfigError, match='datum.latitude_deg'):
         SensorConfig.from_params(params)
 
 

@@ -42,7 +42,7 @@ def test_port_bias_and_zigzag_fits_run(reference, capsys):
     res = validate.run_all(reference, ['port_bias'], zigzags=True)
     assert len(res.checks) == 2 and all(c.ok for c in res.checks)
     assert set(res.fits) == {'land 56/32', 'water 80/0'}
-    # the paper's models in REP 103 axes (sysid.paper_model) turn the simulator's way on its
+    # the paper's models in REP 103 axes (state_space.paper_model) turn the simulator's way on its
     # own zigzags: left in the paper's y-to-starboard frame their yaw-rate fit is below 0 %
     assert all(fits['r'] > 0.0 for fits in res.fits.values()), res.fits
     lines = validate.report(res)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from dukw_estimation import buoyancy
+from dukw_model import buoyancy
 
 R = 0.14
 SLOPE = math.radians(4.5)

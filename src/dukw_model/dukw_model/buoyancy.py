@@ -245,15 +245,6 @@ def grounded_volume_m3(waterline_distance_m: float, slope_rad: float, hull_clear
     return 2.0 * section.line_volume_m3(depth0, gradient, bow_x_m, stern_x_m)
 
 
-def heave_mass_kg(waterplane_area_m2: float, water_density_kgpm3: float, gravity_mps2: float,
-                  heave_natural_hz: float) -> float:
-    """Heave mass (with added mass) that makes the floating vehicle heave at the measured
-    natural frequency: the waterplane stiffness rho g A_W over (2 pi f)^2 (vehicle.md 1, 5)."""
-    if heave_natural_hz <= 0.0 or waterplane_area_m2 <= 0.0:
-        raise ValueError('heave_mass_kg needs a positive waterplane area and frequency')
-    return water_density_kgpm3 * gravity_mps2 * waterplane_area_m2 / (
-        2.0 * math.pi * heave_natural_hz) ** 2
-
 def afloat_dynamic_volume_m3(displacement_n: float, heave_mass_kg_: float,
                              vertical_accel_mps2: float, water_density_kgpm3: float,
                              gravity_mps2: float) -> float:

@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from dukw_estimation import buoyancy
+from dukw_model import buoyancy
 
 R, CLEAR, BOW, STERN = 0.14, 0.25, 1.245, -1.295
 SLOPE = math.radians(4.5)

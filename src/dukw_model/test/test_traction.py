@@ -7,7 +7,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from dukw_common.vehicle import SoilParams
-from dukw_estimation import traction
+from dukw_model import traction
 
 SOIL = SoilParams(cohesion_pa=150.0, friction_angle_rad=math.radians(9.93), shear_modulus_m=0.053)
 L = 1.07

@@ -1,0 +1,1 @@
+"""Physical models of the DUKW-Ling shared by the simulator, the estimator and the tools."""
