@@ -22,7 +22,7 @@ def _imu(t_s):
 
 
 def test_a_drive_status_goes_to_the_drive_its_topic_names(runner):
-    est = runner.estimator
+    est = runner.estimator.motion_filter
     tracks = DriveStatus(1.0, SIDE, SIDE, True, 'tracks')
     props = DriveStatus(1.0, SIDE, SIDE, True, 'props')
     runner.on_sample(reading_topic(tracks), tracks, 1.0)
@@ -48,6 +48,7 @@ def test_an_unknown_topic_is_refused_and_changes_nothing(runner):
     with pytest.raises(ValueError, match='drive'):
         reading_topic(DriveStatus(1.0, SIDE, SIDE))
     assert runner.estimator.t_s is None
+    assert runner.estimator.motion_filter.tracks is None
 
 
 def test_publishes_on_each_imu_sample_and_the_timer_only_while_the_imu_is_silent(runner):
