@@ -29,7 +29,7 @@ CMD_VEL_EVERY = 10        # the scripted cmd_vel comes at 10 Hz
 
 
 @dataclass(frozen=True)
-class Scenario:
+class GoldenScenario:
     """A golden run: where it starts, what cmd_vel asks, for how long, with which seed."""
 
     name: str
@@ -53,12 +53,12 @@ def _straight(speed_mps: float) -> Callable[[float], tuple[float, float]]:
 
 #: Short runs: about 55 kB of MCAP (zstd) per second of the 100 Hz stack, so 7-10 s each.
 SCENARIOS = {s.name: s for s in (
-    Scenario('land_circle', 'on flat dry sand: 0.5 m/s with 0.3 rad/s yaw rate (r ~ 1.7 m)',
+    GoldenScenario('land_circle', 'on flat dry sand: 0.5 m/s with 0.3 rad/s yaw rate (r ~ 1.7 m)',
              start_x_m=-8.0, start_yaw_rad=0.0, duration_s=7.0, seed=11, cmd_vel=_circle),
-    Scenario('land_to_sea', 'from the sand 0.5 m above the waterline straight out to sea: '
+    GoldenScenario('land_to_sea', 'from the sand 0.5 m above the waterline straight out to sea: '
              'LAND -> TRANSITION -> WATER', start_x_m=-0.5, start_yaw_rad=0.0,
              duration_s=9.0, seed=12, cmd_vel=_straight(1.2)),
-    Scenario('sea_to_land', 'afloat 6.8 m out, bow to the beach, up onto the sand: '
+    GoldenScenario('sea_to_land', 'afloat 6.8 m out, bow to the beach, up onto the sand: '
              'WATER -> TRANSITION -> LAND', start_x_m=6.8, start_yaw_rad=math.pi,
              duration_s=10.0, seed=13, cmd_vel=_straight(1.2)),
 )}
@@ -159,7 +159,7 @@ def _describe(wire: BagWire, config_path: str | None) -> None:
     wire.carry('tf_static', 0, tf_message(model.static_transforms(), s_to_stamp(0.0)))
 
 
-def run(scenario: Scenario, writer: BagWriter, config_path: str | None = None) -> ClosedLoop:
+def run(scenario: GoldenScenario, writer: BagWriter, config_path: str | None = None) -> ClosedLoop:
     """The scenario on the in-process stack, every publication through the bag."""
     wire = BagWire(writer, config_path)
     _describe(wire, config_path)
@@ -173,7 +173,7 @@ def run(scenario: Scenario, writer: BagWriter, config_path: str | None = None) -
     return stack
 
 
-def generate(scenario: Scenario, out_dir: Path, config_path: str | None = None) -> Path:
+def generate(scenario: GoldenScenario, out_dir: Path, config_path: str | None = None) -> Path:
     """Write the golden bag of ``scenario`` to ``out_dir/<name>`` (replaced); return it."""
     bag = Path(out_dir) / scenario.name
     if bag.exists():

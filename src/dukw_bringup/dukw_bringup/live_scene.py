@@ -147,7 +147,7 @@ def vehicle_parts(model: VehicleModel, alpha: float = 1.0) -> list[Part]:
 
 
 @dataclass(frozen=True)
-class Datum:
+class MapOrigin:
     """The odom origin on the earth (the EKF's ``datum.*``)."""
 
     latitude_deg: float

@@ -30,7 +30,7 @@ from dukw_driver.mavlink_signing import SecureSigning
 from dukw_driver.shore_mission import MissionProtocol, PlanWaypoint
 from dukw_driver.shore_params import STREAM_PARAM_NAMES, FailsafeAction, ParamTable, Tuning
 from dukw_driver.shore_telemetry import (HOLDER_NAMES, MODE_NAMES, MODE_SAFE_STOP, STREAM_IDS,
-                                         Datum, Drive, RateScheduler, TelemetryEncoder,
+                                         Datum, DriveTelemetry, RateScheduler, TelemetryEncoder,
                                          VehicleState)
 
 MODE_AUTOMATIC = 4
@@ -402,9 +402,9 @@ class ShoreLink:
                             f'{detail}')
         s.holder, s.rc_link_ok, s.authority_detail = holder, rc_link_ok, detail
 
-    def update_drive(self, which: str, drive: Drive) -> None:
+    def update_drive(self, which: str, drive: DriveTelemetry) -> None:
         """tracks/status or props/status: new faults are reported in a STATUSTEXT."""
-        old: Drive = getattr(self.state, which)
+        old: DriveTelemetry = getattr(self.state, which)
         new_faults = [f for f in drive.faults if f not in old.faults]
         if new_faults:
             self.statustext('error', f'{which} fault: {", ".join(new_faults)}')

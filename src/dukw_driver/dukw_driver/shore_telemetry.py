@@ -67,7 +67,7 @@ class Fix:
 
 
 @dataclass
-class Drive:
+class DriveTelemetry:
     """tracks/status or props/status: per side current, voltage, command; the faults' names."""
 
     connected: bool = False
@@ -99,8 +99,8 @@ class VehicleState:
     holder: int | None = None
     rc_link_ok: bool = False
     authority_detail: str = ''
-    tracks: Drive = field(default_factory=Drive)
-    props: Drive = field(default_factory=Drive)
+    tracks: DriveTelemetry = field(default_factory=DriveTelemetry)
+    props: DriveTelemetry = field(default_factory=DriveTelemetry)
     traction: TractionState = field(default_factory=TractionState)
 
 
@@ -213,7 +213,7 @@ class TelemetryEncoder:
         return messages
 
     @staticmethod
-    def _pack(drive: Drive) -> tuple[float, float]:
+    def _pack(drive: DriveTelemetry) -> tuple[float, float]:
         volts = [v for v in drive.voltage_v if math.isfinite(v)]
         amps = [abs(a) for a in drive.current_a if math.isfinite(a)]
         return (max(volts) if volts else math.nan, sum(amps) if amps else math.nan)

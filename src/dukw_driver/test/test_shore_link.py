@@ -13,7 +13,7 @@ from dukw_driver.mavlink_signing import (SecureSigning, TimestampStore, generate
                                          signing_timestamp)
 from dukw_driver.shore_link import (DriveCommand, MissionHold, MissionPlan, ModeRequest,
                                     ShoreLink, settings_from_params)
-from dukw_driver.shore_telemetry import Drive, Fix, Pose, TractionState
+from dukw_driver.shore_telemetry import DriveTelemetry, Fix, Pose, TractionState
 from shore_gcs import KEY, WRONG_KEY, Gcs
 
 
@@ -29,7 +29,7 @@ def full_state(link):
     link.state.fix = Fix(36.18, -75.75, 1.0, 2, 0.3, 0.6)
     link.update_mode(0, True, 'on the sand')
     link.update_authority(1, True, 'startup')
-    drive = Drive(True, (20.0, 22.0), (24.5, 24.4), (50.0, 52.0))
+    drive = DriveTelemetry(True, (20.0, 22.0), (24.5, 24.4), (50.0, 52.0))
     link.update_drive('tracks', drive)
     link.update_drive('props', drive)
     link.state.traction = TractionState((0.1, 0.12), 0.05, 0.9, False)
@@ -165,7 +165,7 @@ def test_telemetry_reports_the_vehicle_in_mavlink_frames():
     texts = [m.text for m in gcs.of_type('STATUSTEXT')]
     assert 'mode LAND: on the sand' in texts
     assert 'mode WATER (forced): forced by operator' in texts
-    link.update_drive('tracks', Drive(True, faults=('overheat',)))
+    link.update_drive('tracks', DriveTelemetry(True, faults=('overheat',)))
     link.update_authority(0, True, 'rc switch')
     link.tick(3.0)
     gcs.feed(link.take_output())

@@ -94,7 +94,7 @@ def test_simulator_land_56_32_validates_on_100_80(zigzags, tmp_path, capsys):
     assert paper['fit_pct']['r'] > paper['paper_fit_pct']['r']
 
 
-def _write_bag(path, run: maneuver.Run, medium_code: int, rate_hz: float = 50.0,
+def _write_bag(path, run: maneuver.ManeuverRun, medium_code: int, rate_hz: float = 50.0,
                topics=('tracks/cmd', 'odometry/filtered', 'sim/truth')):
     """A rosbag2 of the run written with the project's bag writer (truth as odometry)."""
     from dukw_bringup.bag_io import BagWriter, typestore

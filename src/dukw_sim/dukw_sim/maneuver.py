@@ -59,7 +59,7 @@ _TETHER_DAMPING_N_PER_MPS = 60.0
 
 
 @dataclass
-class Run:
+class ManeuverRun:
     """A manoeuvre's record: every step's Truth and the JSON summary."""
 
     name: str
@@ -90,7 +90,7 @@ def fit_circle(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
     return float(cx), float(cy), float(math.sqrt(max(r + cx * cx + cy * cy, 0.0)))
 
 
-def _drive(sim: SimCore, run: Run, duration_s: float,
+def _drive(sim: SimCore, run: ManeuverRun, duration_s: float,
            command: Callable[[float], Actuation],
            hook: Callable[[SimCore], None] | None = None) -> None:
     run.rows.append(sim.truth)
@@ -117,7 +117,7 @@ def _rms(values: np.ndarray) -> float:
 
 
 def circle(medium: str, port: float, stbd: float, duration_s: float = 30.0, seed: int = 0,
-           config: str | None = None) -> Run:
+           config: str | None = None) -> ManeuverRun:
     """Constant commands on flat sand (tracks) or afloat (propellers); fit the circle."""
     sim = SimCore.from_config(config, seed=seed)
     if medium == 'land':
@@ -126,7 +126,7 @@ def circle(medium: str, port: float, stbd: float, duration_s: float = 30.0, seed
     else:
         sim.reset('afloat')
         act = _props(port, stbd)
-    run = Run('circle')
+    run = ManeuverRun('circle')
     _drive(sim, run, duration_s, lambda t: act)
     settle = min(10.0, duration_s / 3.0)
     x, y = run.array(lambda t: t.x_m, settle), run.array(lambda t: t.y_m, settle)
@@ -147,7 +147,7 @@ def circle(medium: str, port: float, stbd: float, duration_s: float = 30.0, seed
 
 def zigzag(medium: str, high: float, low: float, period_s: float = 10.0,
            duration_s: float = 30.0, seed: int = 0, config: str | None = None,
-           lead_in_s: float = 0.0) -> Run:
+           lead_in_s: float = 0.0) -> ManeuverRun:
     """Alternate (high, low) and (low, high) every ``period_s`` (the paper's zigzag tests).
 
     ``lead_in_s`` of zero commands at rest come first (as a field recording started
@@ -169,7 +169,7 @@ def zigzag(medium: str, high: float, low: float, period_s: float = 10.0,
         first = int((t - lead_in_s) // period_s) % 2 == 0
         return make(high, low) if first else make(low, high)
 
-    run = Run('zigzag')
+    run = ManeuverRun('zigzag')
     _drive(sim, run, lead_in_s + duration_s, command)
     r = run.array(lambda t: t.yaw_rate_rps)
     run.summary = {
@@ -184,7 +184,7 @@ def zigzag(medium: str, high: float, low: float, period_s: float = 10.0,
 
 
 def incline(slope_deg: float, command: float, duration_s: float = 14.0, seed: int = 0,
-            config: str | None = None, stbd: float | None = None) -> Run:
+            config: str | None = None, stbd: float | None = None) -> ManeuverRun:
     """Climb a dry-sand slope of ``slope_deg`` with both tracks at ``command`` %.
 
     ``stbd`` sets the starboard track apart (e.g. 96 with 100: the 4 % port bias).
@@ -195,7 +195,7 @@ def incline(slope_deg: float, command: float, duration_s: float = 14.0, seed: in
         'site.beach_slope_rad': math.radians(slope_deg),
         'world.flat_start_x_m': -_INCLINE_LENGTH_M})
     sim.reset(x_m=_INCLINE_START_X_M, yaw_rad=math.pi)
-    run = Run('incline')
+    run = ManeuverRun('incline')
     stbd = command if stbd is None else stbd
     _drive(sim, run, duration_s, lambda t: _tracks(command, stbd))
     half = duration_s / 2.0
@@ -229,7 +229,7 @@ def _wave_overrides(height_m: float, period_s: float | None) -> dict:
 
 def transition(direction: str, command: float, wave_height_m: float = 0.0,
                wave_period_s: float | None = None, slope_deg: float | None = None,
-               duration_s: float = 30.0, seed: int = 0, config: str | None = None) -> Run:
+               duration_s: float = 30.0, seed: int = 0, config: str | None = None) -> ManeuverRun:
     """Tracks only, propellers off: sand to afloat or afloat to sand (paper section 6)."""
     overrides = _wave_overrides(wave_height_m, wave_period_s)
     if slope_deg is not None:
@@ -239,7 +239,7 @@ def transition(direction: str, command: float, wave_height_m: float = 0.0,
         sim.reset('sand')
     else:
         sim.reset('sea', yaw_rad=math.pi)
-    run = Run('transition')
+    run = ManeuverRun('transition')
     _drive(sim, run, duration_s, lambda t: _tracks(command, command))
     media = [t.medium for t in run.rows]
     contact = run.array(lambda t: float(t.in_ground_contact))
@@ -262,7 +262,7 @@ def transition(direction: str, command: float, wave_height_m: float = 0.0,
 
 
 def drift(wave_height_m: float, duration_s: float = 60.0, wave_period_s: float | None = None,
-          seed: int = 0, config: str | None = None) -> Run:
+          seed: int = 0, config: str | None = None) -> ManeuverRun:
     """Afloat, bow to the beach in following seas, loosely held in place by a tether."""
     sim = SimCore.from_config(config, seed=seed,
                               overrides=_wave_overrides(wave_height_m, wave_period_s))
@@ -277,7 +277,7 @@ def drift(wave_height_m: float, duration_s: float = 60.0, wave_period_s: float |
                              -_TETHER_STIFFNESS_N_PER_M * (s.y - y0)
                              - _TETHER_DAMPING_N_PER_MPS * vy)
 
-    run = Run('drift')
+    run = ManeuverRun('drift')
     _drive(sim, run, duration_s, lambda t: Actuation(), hook=hold)
     settle = min(5.0, duration_s / 4.0)
     run.summary = {
@@ -362,8 +362,8 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def run_from_args(args: argparse.Namespace) -> Run:
-    """Run the manoeuvre the parsed arguments name."""
+def run_from_args(args: argparse.Namespace) -> ManeuverRun:
+    """ManeuverRun the manoeuvre the parsed arguments name."""
     common = {'seed': args.seed, 'config': args.config}
     if args.maneuver == 'circle':
         return circle(args.medium, args.port, args.stbd, args.duration, **common)

@@ -30,7 +30,7 @@ from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS
 from dukw_common.readings import (DepthReading, DriveStatus, GpsFix, GpsVelocity, ImuSample,
                                   MotorSide, WaterContact, reading_topic)
 from dukw_driver.authority import AuthorityState
-from dukw_sim.switch import RcReading
+from dukw_sim.switch import RcPulses
 from dukw_sim.truth import Truth
 
 #: What sim_node publishes: the drivers' topic contract (architecture.md) plus sim/truth, /clock.
@@ -212,7 +212,7 @@ class SimMessages:
         _fill_side(msg.stbd, r.stbd)
         return msg
 
-    def rc_input(self, r: RcReading) -> RcInput:
+    def rc_input(self, r: RcPulses) -> RcInput:
         """dukw_msgs/RcInput."""
         msg = self._rc
         set_stamp(msg.header, r.t_s)

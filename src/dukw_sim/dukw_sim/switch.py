@@ -45,7 +45,7 @@ class OperatorState:
 
 
 @dataclass(frozen=True)
-class RcReading:
+class RcPulses:
     """The RC side as the servo controller reads it (dukw_msgs/RcInput)."""
 
     t_s: float
@@ -111,12 +111,12 @@ class SimServoSwitch:
             return SwitchOutputs(computer['tracks'], computer['props'], 'computer')
         return SwitchOutputs(NEUTRAL, NEUTRAL, 'neutral')
 
-    def rc_reading(self, t_s: float) -> RcReading:
+    def rc_reading(self, t_s: float) -> RcPulses:
         """The four stick channels (the servo switch's stick_channels, in its output order:
         tracks port, stbd, props port, stbd) around neutral, none without link."""
         op, ch = self.operator, self.channels
         if not op.rc_link_ok:
-            return RcReading(t_s, False, op.rc_selected, (0.0,) * 4)
+            return RcPulses(t_s, False, op.rc_selected, (0.0,) * 4)
         port = ch.neutral_us + ch.us_per_pct * op.sticks.port_pct
         stbd = ch.neutral_us + ch.us_per_pct * op.sticks.stbd_pct
-        return RcReading(t_s, True, op.rc_selected, (port, stbd, port, stbd))
+        return RcPulses(t_s, True, op.rc_selected, (port, stbd, port, stbd))

@@ -169,7 +169,7 @@ def inclines(ref: dict, res: Results, seed: int, config: str | None) -> None:
     res.series['inclines'] = rows
 
 
-def surf_force_per_track_n(run: maneuver.Run) -> float:
+def surf_force_per_track_n(run: maneuver.ManeuverRun) -> float:
     """Mean soil force per track while the tracks carry weight in the surf, N."""
     forces = [0.5 * (t.port_force_n + t.stbd_force_n) for t in run.rows
               if t.medium == Medium.TRANSITION and t.effective_weight_n > 0.0]

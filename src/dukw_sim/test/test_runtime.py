@@ -12,7 +12,7 @@ from dukw_driver.authority import AuthorityState, Holder, Reason
 from dukw_sim.runtime import Pacer, SpeedMeter, sim_healths
 from dukw_sim.sensors import Fault
 from dukw_sim.sim_messages import TOPICS, Frames, SimMessages
-from dukw_sim.switch import RcReading
+from dukw_sim.switch import RcPulses
 from dukw_sim.truth import Medium, Truth
 
 DT = 0.01
@@ -153,7 +153,7 @@ def test_every_sim_truth_field_is_filled_from_truth():
 
 def test_rc_authority_and_clock_messages():
     msgs = SimMessages(FRAMES)
-    rc = msgs.rc_input(RcReading(4.0, True, True, (1350.0, 1600.0)))
+    rc = msgs.rc_input(RcPulses(4.0, True, True, (1350.0, 1600.0)))
     assert rc.rc_selected and list(rc.channels_us) == [1350.0, 1600.0]
     state = AuthorityState(Holder.RC, Reason.RC_SWITCH, True, False, 'RC operator')
     auth = msgs.authority(state, 4.0)
