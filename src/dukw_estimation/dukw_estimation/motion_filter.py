@@ -26,6 +26,15 @@ MAX_PREDICT_STEP_S = 0.02
 GROUNDED_FRACTION = 0.5          # above this weight share the tracks drive the vehicle
 
 
+#: the odometry covariances (REP 105 order x y z roll pitch yaw / vx vy vz wx wy wz): what the
+#: filter does not estimate is fixed; the rest is copied from P with precomputed indices
+_POSE_COV_BASE = np.diag([0.0, 0.0, 1e3, 1e-2, 1e-2, 0.0])
+_TWIST_COV_BASE = np.diag([0.0, 0.0, 1e3, 1e3, 1e3, 0.0])
+_POSE_AT = np.ix_([0, 1, 5], [0, 1, 5])
+_POSE_FROM = np.ix_([Idx.X, Idx.Y, Idx.YAW], [Idx.X, Idx.Y, Idx.YAW])
+_TWIST_AT = np.ix_([0, 1], [0, 1])
+_TWIST_FROM = np.ix_([Idx.U, Idx.V], [Idx.U, Idx.V])
+
 class MotionFilter:
     """Pose, twist, gyro bias and GPS bias of base_link in odom (and the EKF's time)."""
 
@@ -259,16 +268,11 @@ class MotionFilter:
         x, P = self.ekf.x, self.ekf.P
         roll = self.imu.roll_rad if self.imu else 0.0
         pitch = self.imu.pitch_rad if self.imu else 0.0
-        pose_cov = np.diag([0.0, 0.0, 1e3, 1e-2, 1e-2, 0.0])
-        ix = [Idx.X, Idx.Y]
-        pose_cov[np.ix_([0, 1], [0, 1])] = P[np.ix_(ix, ix)]
-        pose_cov[np.ix_([0, 1], [5])] = P[np.ix_(ix, [Idx.YAW])]
-        pose_cov[np.ix_([5], [0, 1])] = P[np.ix_([Idx.YAW], ix)]
-        pose_cov[5, 5] = P[Idx.YAW, Idx.YAW]
-        twist_cov = np.diag([0.0, 0.0, 1e3, 1e3, 1e3, 0.0])
-        it = [Idx.U, Idx.V]
-        twist_cov[np.ix_([0, 1], [0, 1])] = P[np.ix_(it, it)]
-        twist_cov[5, 5] = P[Idx.R, Idx.R]
+        pose_cov = _POSE_COV_BASE.copy()
+        pose_cov[_POSE_AT] = P[_POSE_FROM]          # x, y, yaw of the filter -> x, y, yaw
+        twist_cov = _TWIST_COV_BASE.copy()
+        twist_cov[_TWIST_AT] = P[_TWIST_FROM]       # u, v -> vx, vy
+        twist_cov[5, 5] = P[Idx.R, Idx.R]           # r -> wz (no u, v - r terms)
         z = -x[Idx.S] * math.sin(slope_rad)
         return OdometryEstimate(self.t_s or 0.0, float(x[Idx.X]), float(x[Idx.Y]), z, roll,
                                 pitch, float(x[Idx.YAW]), float(x[Idx.U]), float(x[Idx.V]),

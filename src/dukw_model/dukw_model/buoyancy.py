@@ -64,10 +64,13 @@ def submerged_volume_on_slope(h2_m: ArrayLike, slope_rad: float, radius_m: float
 def segment_area_m2(depth_m: ArrayLike, radius_m: float) -> ArrayLike:
     """Immersed cross-section of a horizontal circle of radius r, water depth d over its bottom."""
     r = radius_m
+    if np.ndim(depth_m) == 0:                   # the scalar path, without numpy's overhead
+        h = r - min(max(float(depth_m), 0.0), 2.0 * r)
+        return (r * r * math.acos(min(max(h / r, -1.0), 1.0))
+                - h * math.sqrt(max(r * r - h * h, 0.0)))
     d = np.clip(np.asarray(depth_m, dtype=float), 0.0, 2.0 * r)
     h = r - d
-    out = r * r * np.arccos(np.clip(h / r, -1.0, 1.0)) - h * np.sqrt(np.maximum(r * r - h * h, 0))
-    return float(out) if out.ndim == 0 else out
+    return r * r * np.arccos(np.clip(h / r, -1.0, 1.0)) - h * np.sqrt(np.maximum(r * r - h * h, 0))
 
 
 def segment_area_integral_m3_per_m(depth_m: float, radius_m: float) -> float:
