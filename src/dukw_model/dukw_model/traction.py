@@ -9,6 +9,8 @@ every function takes floats or numpy arrays.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from dukw_common.vehicle import SoilParams
@@ -24,6 +26,10 @@ def slip(track_speed_mps: ArrayLike, ground_speed_mps: ArrayLike,
     the track's sign), so a stopped track with a moving vehicle gives a large
     negative slip instead of infinity; the result is clipped to [-1, 1].
     """
+    if np.ndim(track_speed_mps) == 0 and np.ndim(ground_speed_mps) == 0:   # scalar path
+        v_t, v_r = float(track_speed_mps), float(ground_speed_mps)
+        denom = max(abs(v_t), min_track_speed_mps) * (1.0 if v_t >= 0.0 else -1.0)
+        return min(max((v_t - v_r) / denom, -1.0), 1.0)
     v_t = np.asarray(track_speed_mps, dtype=float)
     v_r = np.asarray(ground_speed_mps, dtype=float)
     sign = np.where(v_t >= 0.0, 1.0, -1.0)
@@ -38,6 +44,12 @@ def shear_development(slip_abs: ArrayLike, contact_length_m: float,
 
     Safe at |i| -> 0 (series 1 - (1 - x/2) = x/2) and at k -> 0 (-> 1).
     """
+    if np.ndim(slip_abs) == 0:                                          # scalar path
+        s = abs(float(slip_abs))
+        if shear_modulus_m <= 1e-9:
+            return 1.0 if s > 0.0 else 0.0
+        x = s * contact_length_m / shear_modulus_m
+        return x / 2.0 if x < 1e-6 else 1.0 + float(np.expm1(-x)) / x   # numpy: same bits
     s = np.abs(np.asarray(slip_abs, dtype=float))
     if shear_modulus_m <= 1e-9:  # k -> 0: shear fully developed at any slip
         out = np.where(s > 0.0, 1.0, 0.0)
@@ -66,6 +78,12 @@ def tractive_force_n(slip_: ArrayLike, effective_weight_n: ArrayLike, soil: Soil
     for one track. No weight on the tracks (afloat) gives no cohesion either:
     the patch is off the ground.
     """
+    if np.ndim(slip_) == 0 and np.ndim(effective_weight_n) == 0:        # scalar path
+        i, w = float(slip_), max(float(effective_weight_n), 0.0)
+        sign = math.copysign(1.0, i) if i != 0.0 else 0.0      # as np.sign: +0 at either zero
+        tan_phi = float(np.tan(soil.friction_angle_rad))       # numpy: the same bits
+        strength = contact_area_m2 * soil.cohesion_pa + w * tan_phi if w > 0.0 else 0.0
+        return sign * strength * shear_development(i, contact_length_m, soil.shear_modulus_m)
     i = np.asarray(slip_, dtype=float)
     w = np.maximum(np.asarray(effective_weight_n, dtype=float), 0.0)
     strength = np.where(w > 0.0, max_traction_n(w, soil, contact_area_m2), 0.0)

@@ -93,3 +93,26 @@ def test_track_force_on_the_vehicle_follows_the_belt_against_the_ground():
     assert traction.track_force_n(0.0, -0.5, w, SOIL, a, l_m) > 0.0     # braking, rolling back
     vec = traction.track_force_n(np.array([1.0, -1.0]), np.array([0.8, -0.8]), w, SOIL, a, l_m)
     assert vec.tolist() == pytest.approx([forward, -forward])
+
+
+def test_the_scalar_path_gives_the_array_path_bit_for_bit():
+    """The simulator and the EKF call these per track and per step with floats: the fast
+    scalar path must give exactly the vectorised result, signed zeros included."""
+    import math
+
+    import numpy as np
+
+    from dukw_common.vehicle import SoilParams
+    from dukw_model import traction as tr
+    soil = SoilParams(1200.0, 0.55, 0.04)
+    rng = np.random.default_rng(3)
+    speeds = rng.normal(0.0, 1.0, (4000, 2))
+    speeds[::10, 0] = 0.0                              # stopped tracks
+    for v_t, v_r in speeds:
+        i = tr.slip(v_t, v_r)
+        assert i == tr.slip(np.array([v_t]), np.array([v_r]))[0]
+        for slip_ in (i, 0.0, -0.0):
+            w = rng.normal(500.0, 800.0)               # some without weight (afloat)
+            one = tr.tractive_force_n(slip_, w, soil, 0.5, 1.2)
+            many = tr.tractive_force_n(np.array([slip_]), np.array([w]), soil, 0.5, 1.2)[0]
+            assert one == many and math.copysign(1.0, one) == math.copysign(1.0, many)
