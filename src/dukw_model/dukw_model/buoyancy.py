@@ -66,7 +66,7 @@ def segment_area_m2(depth_m: ArrayLike, radius_m: float) -> ArrayLike:
     r = radius_m
     if np.ndim(depth_m) == 0:                   # the scalar path, without numpy's overhead
         h = r - min(max(float(depth_m), 0.0), 2.0 * r)
-        return (r * r * math.acos(min(max(h / r, -1.0), 1.0))
+        return (r * r * float(np.arccos(min(max(h / r, -1.0), 1.0)))   # numpy: same bits
                 - h * math.sqrt(max(r * r - h * h, 0.0)))
     d = np.clip(np.asarray(depth_m, dtype=float), 0.0, 2.0 * r)
     h = r - d
@@ -138,6 +138,10 @@ class HullSection:
 
     def area_m2(self, depth_m: ArrayLike) -> ArrayLike:
         """Immersed section from the water height over the hull bottom, m^2 (vectorised)."""
+        if np.ndim(depth_m) == 0:                   # the scalar path, without numpy's overhead
+            d = min(float(depth_m), self.top_depth_m)
+            return (segment_area_m2(min(d, self.float_depth_m), self.radius_m)
+                    + self.strut_width_m * max(d - self.float_depth_m, 0.0))
         d = np.minimum(np.asarray(depth_m, dtype=float), self.top_depth_m)
         out = segment_area_m2(np.minimum(d, self.float_depth_m), self.radius_m) \
             + self.strut_width_m * np.maximum(d - self.float_depth_m, 0.0)

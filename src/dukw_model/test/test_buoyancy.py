@@ -137,3 +137,14 @@ def test_grounded_volume_is_the_papers_formula_while_the_stern_is_dry(s):
     assert 0.0 < h2 < 2.54                               # bow wet, stern dry
     expected = 2.0 * buoyancy.hull_volume_on_slope(h2, SLOPE, R)
     assert buoyancy.grounded_volume_m3(*args, R) == pytest.approx(expected, rel=1e-9)
+
+
+def test_the_scalar_section_gives_the_array_section_bit_for_bit():
+    """Per-strip and per-hull calls take floats: the scalar path must match the array path."""
+    import numpy as np
+
+    from dukw_model.buoyancy import HullSection, segment_area_m2
+    section = HullSection(0.3, 0.45, 0.2, 0.9)
+    for depth in np.random.default_rng(5).uniform(-0.2, 1.2, 5000):
+        assert segment_area_m2(float(depth), 0.3) == segment_area_m2(np.array([depth]), 0.3)[0]
+        assert section.area_m2(float(depth)) == section.area_m2(np.array([depth]))[0]
