@@ -70,7 +70,20 @@ def build(names: Sequence[str]) -> list[Node]:
         factory = getattr(import_module(module), cls)
         nodes[name] = factory(handed_topics=handed) if name in CHAIN else factory()
     wire(nodes)
+    share_clock(list(nodes.values()))
     return list(nodes.values())
+
+
+def share_clock(nodes: list[Node]) -> None:
+    """One /clock subscription for the process: under use_sim_time every node's
+    TimeSource would subscribe /clock (100 Hz each); the first node's drives all clocks.
+    (rclpy keeps the TimeSource private: ``_time_source``, as rclpy's own Node sets it.)"""
+    if not all(node.get_parameter('use_sim_time').value for node in nodes):
+        return
+    source = nodes[0]._time_source
+    for node in nodes[1:]:
+        node._time_source.detach_node()
+        source.attach_clock(node.get_clock())
 
 
 def wire(nodes: dict[str, Node]) -> None:

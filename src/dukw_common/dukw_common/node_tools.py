@@ -4,6 +4,7 @@ This is the only module of dukw_common that imports rclpy.
 """
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import sys
@@ -156,8 +157,10 @@ def run_nodes(factory: Callable[[], Sequence[Node]], args: list[str] | None = No
         executor = executor_factory()
         for node in nodes:
             executor.add_node(node)
-        while not stop.is_set() and rclpy.ok():
-            executor.spin_once(timeout_sec=0.05)
+        with profiled(os.environ.get(PROFILE_ENV, '').format(
+                node=nodes[-1].get_name() if nodes else '', pid=os.getpid())):
+            while not stop.is_set() and rclpy.ok():
+                executor.spin_once(timeout_sec=0.05)
     except ExternalShutdownException:
         pass                     # the node ended itself (context.try_shutdown()): exit 0
     except ConfigError as exc:
@@ -166,6 +169,32 @@ def run_nodes(factory: Callable[[], Sequence[Node]], args: list[str] | None = No
     finally:
         _shut_down(nodes)
     return code
+
+
+#: DUKW_PROFILE=FILE: profile the spin loop with cProfile, stats as text to FILE on exit;
+#: ``{node}`` in FILE is the (last) node's name, ``{pid}`` the process id
+PROFILE_ENV = 'DUKW_PROFILE'
+
+
+@contextlib.contextmanager
+def profiled(path: str | None):
+    """cProfile the block when ``path`` is given; write its stats (cumulative) as text."""
+    if not path:
+        yield
+        return
+    import cProfile
+    import io
+    import pstats
+    profile = cProfile.Profile()
+    profile.enable()
+    try:
+        yield
+    finally:
+        profile.disable()
+        text = io.StringIO()
+        pstats.Stats(profile, stream=text).sort_stats('tottime').print_stats(40)
+        with open(path, 'w') as out:
+            out.write(text.getvalue())
 
 
 def _shut_down(nodes: Sequence[Node]) -> None:

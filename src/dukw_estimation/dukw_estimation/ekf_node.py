@@ -24,6 +24,7 @@ from dukw_common.diagnostics import Health, Level
 from dukw_common.node_tools import (COMMAND_QOS, ParamSpec, declare_parameters,
                                     diagnostic_array, refuse_second_client, run_node,
                                     s_to_stamp, subscribe_sensors, vehicle_specs)
+from dukw_common.rates import Decimator
 from dukw_common.sources import SourceWatch
 from dukw_common.tf_tools import TF_QOS, odometry_tf
 from dukw_estimation import ros_convert as conv
@@ -44,6 +45,8 @@ class EkfNode(Node):
         specs.append(ParamSpec('publish_on_imu', 'publish after each IMU sample, not only on '
                                'the timer'))
         specs.append(ParamSpec('publish_tf', 'broadcast odom -> base_link on /tf'))
+        specs += [ParamSpec(f'{name}_rate_hz', f'most {name} messages a second (observers)',
+                            min=0.1, max=1000.0) for name in ('tf', 'traction')]
         specs += [ParamSpec(f'soil_presets.{name}', 'soil preset value (vehicle.md 6)', min=0.0)
                   for name in section(node_params('ekf_node'), 'soil_presets')
                   if name != 'names']
@@ -56,6 +59,8 @@ class EkfNode(Node):
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
         self.tf_pub = (self.create_publisher(TFMessage, '/tf', TF_QOS)
                        if params['publish_tf'] else None)
+        self.tf_due = Decimator(params['tf_rate_hz']).due
+        self.traction_due = Decimator(params['traction_rate_hz']).due
         self.inputs = {topic: (msg_type, self._handler(topic)) for msg_type, topic in (
             (Imu, 'imu/data'), (NavSatFix, 'gps/fix'), (TwistWithCovarianceStamped, 'gps/vel'),
             (WaterContact, 'water/contact'), (Depth, 'depth'),
@@ -90,9 +95,10 @@ class EkfNode(Node):
         self.odom_pub.publish(odom)
         for listen in self.estimate_listeners:   # in-process consumers (commands) first
             listen(estimate)
-        if self.tf_pub is not None:
+        if self.tf_pub is not None and self.tf_due(estimate.t_s):
             self.tf_pub.publish(odometry_tf(odom))
-        self.traction_pub.publish(conv.traction_msg(estimate.traction, stamp, Traction))
+        if self.traction_due(estimate.t_s):
+            self.traction_pub.publish(conv.traction_msg(estimate.traction, stamp, Traction))
 
     def _on_diagnostics(self) -> None:
         healths = self.estimator.health(self._now_s())
