@@ -33,11 +33,14 @@ def test_workspace_stacks_parse():
         n.executable for n in boat.nodes}
 
 
-def test_both_sim_stack_shapes_load_with_the_same_nodes():
-    """One process per node (sim) and the control chain composed (sim_composed, the main
-    job's) run the same ROS nodes; the composed process lists its nodes as arguments."""
+@pytest.mark.parametrize('shape', ['sim', 'boat'])
+def test_both_stack_shapes_load_with_the_same_nodes(shape):
+    """One process per node (sim, boat) and the control chain composed (sim_composed, the
+    main job's; boat_composed) run the same ROS nodes; the composed process lists its
+    nodes as arguments."""
     from dukw_bringup.bringup import node_command
-    separate, composed = load_stack(stack_path('sim')), load_stack(stack_path('sim_composed'))
+    separate = load_stack(stack_path(shape))
+    composed = load_stack(stack_path(f'{shape}_composed'))
     assert sorted(separate.node_names()) == sorted(composed.node_names())
     assert all(not spec.composes for spec in separate.nodes)
     chain = composed.node('control_chain')
@@ -63,7 +66,8 @@ def test_the_run_overlay_puts_every_composed_node_on_sim_time(tmp_path):
 
 def test_sim_stack_runs_every_node_but_the_simulator_on_sim_time():
     from dukw_bringup.bringup import node_command
-    for name, expected in (('sim', True), ('sim_composed', True), ('boat', False)):
+    for name, expected in (('sim', True), ('sim_composed', True), ('boat', False),
+                           ('boat_composed', False)):
         stack = load_stack(stack_path(name))
         for spec in stack.nodes:
             command = node_command(spec, [], stack.uses_sim_time(spec))
@@ -73,7 +77,7 @@ def test_sim_stack_runs_every_node_but_the_simulator_on_sim_time():
 
 def test_both_stacks_keep_the_ros_graph_on_the_vehicle_unless_told_otherwise():
     from dukw_bringup.bringup import DISCOVERY_ENV, Runner
-    for name in ('sim', 'sim_composed', 'boat'):
+    for name in ('sim', 'sim_composed', 'boat', 'boat_composed'):
         stack = load_stack(stack_path(name))
         assert Runner(stack, env={DISCOVERY_ENV: ''}).env[DISCOVERY_ENV] == 'LOCALHOST'
         assert Runner(stack, env={DISCOVERY_ENV: 'SUBNET'}).env[DISCOVERY_ENV] == 'SUBNET'
