@@ -20,11 +20,12 @@ which was used). Sensor messages no command followed within 100 ms count as lost
 With ``--cores 1`` the stack's node processes (all but the simulator) are pinned to one
 core with taskset (util-linux), as a stand-in for the boat's small computer.
 
-    python benchmarks/bench_stack.py [--stack sim_composed|sim] [--duration 20] [--warmup 5]
-                                     [--cores 1]
+    python benchmarks/bench_stack.py [--stack sim_composed [--stack sim]] [--duration 20]
+                                     [--warmup 5] [--cores 1]
 
-``--stack`` chooses the bring-up shape: ``sim_composed`` (default, the main job's: the
-control chain as one process, dukw_bringup.compose) or ``sim`` (one process per node).
+``--stack`` chooses the bring-up shape: ``sim_composed`` (the main job's: the control chain
+as one process, dukw_bringup.compose) or ``sim`` (one process per node); by default both in
+turn (the summary names the figures of ``sim``, ``, stack sim``).
 """
 from __future__ import annotations
 
@@ -47,6 +48,8 @@ from dukw_common.config import default_config_path
 from figures import report
 
 SIM_NODE = 'sim_node'
+#: measured in turn by default: the main job's composed shape, then one process per node
+DEFAULT_STACKS = ('sim_composed', 'sim')
 
 class Probe:
     """Receives the chain's topics and notes (receive time, stamp) of each message."""
@@ -113,21 +116,27 @@ def label(stack_name: str, cores: int) -> str:
 
 
 def main() -> int:
-    """Run the stack, measure, print."""
+    """Run each asked stack in turn, measure, print."""
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     parser.add_argument('--duration', type=float, default=20.0, help='measuring window, s')
     parser.add_argument('--warmup', type=float, default=5.0, help='s before measuring')
-    parser.add_argument('--stack', default='sim_composed',
+    parser.add_argument('--stack', action='append',
                         help='stack name (config/stack_<name>.yaml: sim_composed = the control '
                              "chain in one process, the main job's; sim = one process per "
-                             'node) or a stack file')
+                             'node) or a stack file; repeat to measure several in turn '
+                             '(default: sim_composed, then sim: both shapes side by side)')
     parser.add_argument('--cores', type=int, default=0,
                         help='pin the stack (not the simulator) to this many cores; 0 = free')
     args = parser.parse_args()
     if not 0 <= args.cores <= (os.cpu_count() or 1):
         parser.error(f'--cores must be 0..{os.cpu_count()}, not {args.cores}')
+    return max([measure(name, args) for name in args.stack or DEFAULT_STACKS])
+
+
+def measure(stack_name: str, args: argparse.Namespace) -> int:
+    """Run one stack, measure, print; 1 if a node died."""
     run_dir = Path(tempfile.mkdtemp(prefix='bench_stack_'))
-    stack = load_stack(stack_path(args.stack))
+    stack = load_stack(stack_path(stack_name))
     config, overlay = prepare_run(run_dir, default_config_path(), stack, load_mission(), 1.0)
     runner = Runner(stack, [config, overlay], log_dir=run_dir / 'logs', echo=False)
     runner.start()
@@ -189,7 +198,8 @@ def main() -> int:
     report(f'stack CPU without the sim{cores}', 100.0 * without_sim / wall, '% of a core',
            target=25.0, aim=15.0)
     if SIM_NODE in cpu:
-        report('sim_node CPU in the stack run', 100.0 * cpu[SIM_NODE] / wall, '% of a core')
+        report(f'sim_node CPU in the stack run{cores}', 100.0 * cpu[SIM_NODE] / wall,
+               '% of a core')
     return 0
 
 
