@@ -178,7 +178,7 @@ PROFILE_ENV = 'DUKW_PROFILE'
 
 @contextlib.contextmanager
 def profiled(path: str | None):
-    """cProfile the block when ``path`` is given; write its stats (cumulative) as text."""
+    """cProfile the block when ``path`` is given; write its top 40 (by own time) as text."""
     if not path:
         yield
         return
