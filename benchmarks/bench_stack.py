@@ -20,7 +20,12 @@ which was used). Sensor messages no command followed within 100 ms count as lost
 With ``--cores 1`` the stack's node processes (all but the simulator) are pinned to one
 core with taskset (util-linux), as a stand-in for the boat's small computer.
 
-    python benchmarks/bench_stack.py [--duration 20] [--warmup 5] [--cores 1]
+    python benchmarks/bench_stack.py [--stack sim_composed [--stack sim]] [--duration 20]
+                                     [--warmup 5] [--cores 1]
+
+``--stack`` chooses the bring-up shape: ``sim_composed`` (the main job's: the control chain
+as one process, dukw_bringup.compose) or ``sim`` (one process per node); by default both in
+turn (the summary names the figures of ``sim``, ``, stack sim``).
 """
 from __future__ import annotations
 
@@ -43,6 +48,8 @@ from dukw_common.config import default_config_path
 from figures import report
 
 SIM_NODE = 'sim_node'
+#: measured in turn by default: the main job's composed shape, then one process per node
+DEFAULT_STACKS = ('sim_composed', 'sim')
 
 class Probe:
     """Receives the chain's topics and notes (receive time, stamp) of each message."""
@@ -101,18 +108,35 @@ def pin_to_cores(pids: dict[str, int], cores: int) -> str:
             f'computer): {", ".join(pinned)}; {SIM_NODE} not pinned')
 
 
+def label(stack_name: str, cores: int) -> str:
+    """The figure's suffix: which stack shape, how many cores (the main job's shape bare)."""
+    parts = ([] if stack_name == 'sim_composed' else [f'stack {stack_name}']) + (
+        [f'{cores} core(s)'] if cores else [])
+    return ''.join(f', {p}' for p in parts)
+
+
 def main() -> int:
-    """Run the stack, measure, print."""
+    """Run each asked stack in turn, measure, print."""
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     parser.add_argument('--duration', type=float, default=20.0, help='measuring window, s')
     parser.add_argument('--warmup', type=float, default=5.0, help='s before measuring')
+    parser.add_argument('--stack', action='append',
+                        help='stack name (config/stack_<name>.yaml: sim_composed = the control '
+                             "chain in one process, the main job's; sim = one process per "
+                             'node) or a stack file; repeat to measure several in turn '
+                             '(default: sim_composed, then sim: both shapes side by side)')
     parser.add_argument('--cores', type=int, default=0,
                         help='pin the stack (not the simulator) to this many cores; 0 = free')
     args = parser.parse_args()
     if not 0 <= args.cores <= (os.cpu_count() or 1):
         parser.error(f'--cores must be 0..{os.cpu_count()}, not {args.cores}')
+    return max([measure(name, args) for name in args.stack or DEFAULT_STACKS])
+
+
+def measure(stack_name: str, args: argparse.Namespace) -> int:
+    """Run one stack, measure, print; 1 if a node died."""
     run_dir = Path(tempfile.mkdtemp(prefix='bench_stack_'))
-    stack = load_stack(stack_path('sim'))
+    stack = load_stack(stack_path(stack_name))
     config, overlay = prepare_run(run_dir, default_config_path(), stack, load_mission(), 1.0)
     runner = Runner(stack, [config, overlay], log_dir=run_dir / 'logs', echo=False)
     runner.start()
@@ -140,7 +164,10 @@ def main() -> int:
     arrays = {k: np.array(v, dtype=float).reshape(-1, 2) for k, v in probe.records.items()}
     print(f'stack on the simulator (real-time factor 1, 100 Hz), {wall:.1f} s measured; '
           f'logs in {run_dir}/logs')
-    print(f'stack processes {pinning}')
+    shapes = [n.name + (' = ' + '+'.join(n.composes) if n.composes else '')
+              for n in stack.nodes]
+    print(f'stack {stack.name!r}, {len(stack.nodes)} processes ({", ".join(shapes)}); '
+          f'processes {pinning}')
     print('messages received: ' + ', '.join(f'{k} {len(v)}' for k, v in arrays.items()))
     if min(len(v) for v in arrays.values()) == 0:
         print('latency: not measured (a topic of the chain is silent)')
@@ -156,7 +183,7 @@ def main() -> int:
                   f'p50 {p50:.2f} ms  p99 {p99:.2f} ms  max {latencies.max() * 1e3:.2f} ms  '
                   f'n={len(latencies)} lost={lost}   target p99 <= 10 ms '
                   '(issue 16: p50 <= 1 ms, p99 <= 5 ms aiming at 2 ms)')
-            cores = f', {args.cores} core(s)' if args.cores else ''
+            cores = label(stack.name, args.cores)
             report(f'stack latency sensor->command p50{cores}', p50, 'ms', target=1.0)
             report(f'stack latency sensor->command p99{cores}', p99, 'ms', target=5.0, aim=2.0)
         else:
@@ -167,11 +194,12 @@ def main() -> int:
     without_sim = sum(s for n, s in cpu.items() if n != SIM_NODE)
     print(f'  {"stack without the sim":<24} {100.0 * without_sim / wall:6.1f} %'
           '   target <= 25 %, aim 15 %')
-    cores = f', {args.cores} core(s)' if args.cores else ''
+    cores = label(stack.name, args.cores)
     report(f'stack CPU without the sim{cores}', 100.0 * without_sim / wall, '% of a core',
            target=25.0, aim=15.0)
     if SIM_NODE in cpu:
-        report('sim_node CPU in the stack run', 100.0 * cpu[SIM_NODE] / wall, '% of a core')
+        report(f'sim_node CPU in the stack run{cores}', 100.0 * cpu[SIM_NODE] / wall,
+               '% of a core')
     return 0
 
 

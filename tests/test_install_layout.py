@@ -11,7 +11,7 @@ NODES = {
     'dukw_estimation': ['ekf_node'],
     'dukw_control': ['mode_manager_node', 'drive_controller_node'],
     'dukw_sim': ['sim_node'],
-    'dukw_bringup': ['mission_node', 'robot_state_node', 'live_view_node'],
+    'dukw_bringup': ['mission_node', 'robot_state_node', 'live_view_node', 'compose'],
 }
 WORKSPACE = Path(__file__).resolve().parents[1]
 

@@ -24,6 +24,7 @@ setup(
         'console_scripts': [
             # main job and bring-up (issue 7, bring-up helper)
             'bringup = dukw_bringup.bringup:main',
+            'compose = dukw_bringup.compose:main',
             'mission_node = dukw_bringup.mission_node:main',
             'robot_state_node = dukw_bringup.robot_state_node:main',
             'live_view_node = dukw_bringup.live_view_node:main',

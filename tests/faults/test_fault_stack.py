@@ -10,9 +10,9 @@ import subprocess
 import time
 
 import pytest
-from dukw_msgs.msg import DiffCommand
+from dukw_msgs.msg import Authority, DiffCommand
 
-from dukw_common.node_tools import COMMAND_QOS
+from dukw_common.node_tools import COMMAND_QOS, STATE_QOS
 from dukw_common.testing import executable, ros_node, spin_until
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
@@ -55,3 +55,46 @@ def test_killed_ekf_ends_in_neutral_and_stops_the_stack():
             runner.communicate(timeout=60)
     assert runner.returncode == 1
     assert 'ekf_node exited unexpectedly (killed by signal 9)' in out + err
+
+
+def test_killed_composed_chain_ends_in_switch_neutral_and_stops_the_stack():
+    """Composed shape (the main job's): the EKF shares its process with the controller, so
+    killing it kills both; no command comes any more and the servo switch goes neutral
+    on its command timeout (0.5 s; `authority` says COMMAND_TIMEOUT); bringup exits 1."""
+    runner = subprocess.Popen([str(executable('dukw_bringup', 'bringup')), 'sim_composed',
+                               '--quiet'], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              text=True)
+    try:
+        pids = {}
+        deadline = time.monotonic() + 60.0
+        while 'control_chain' not in pids and time.monotonic() < deadline:
+            match = re.search(r'started (\w+) \(pid (\d+)\)', runner.stdout.readline())
+            if match:
+                pids[match.group(1)] = int(match.group(2))
+        tracks, authority = [], []
+        with ros_node('stack_probe') as (node, executor):
+            node.create_subscription(DiffCommand, 'tracks/cmd',
+                                     lambda m: tracks.append((time.monotonic(), m)),
+                                     COMMAND_QOS)
+            node.create_subscription(Authority, 'authority',
+                                     lambda m: authority.append((time.monotonic(), m)),
+                                     STATE_QOS)
+            assert spin_until(executor, lambda: tracks and abs(tracks[-1][1].stbd_pct) > 5.0,
+                              90.0), 'the mission never drove'
+            since = time.monotonic()
+            subprocess.run(['kill', '-KILL', str(pids['control_chain'])], check=True)
+
+            def timed_out():
+                return [t for t, m in authority if t > since and m.outputs_neutral
+                        and m.reason == Authority.REASON_COMMAND_TIMEOUT]
+            assert spin_until(executor, timed_out, 10.0)
+            reaction = timed_out()[0] - since
+        print(f'composed chain killed -> switch neutral: {reaction:.3f} s')
+        assert reaction <= TIMEOUT_S + SLACK_S + 0.1       # + the switch's status period
+        out, err = runner.communicate(timeout=60)
+    finally:
+        if runner.poll() is None:
+            runner.send_signal(signal.SIGINT)
+            runner.communicate(timeout=60)
+    assert runner.returncode == 1
+    assert 'control_chain exited unexpectedly (killed by signal 9)' in out + err

@@ -10,7 +10,9 @@ file (config/stack_sim.yaml, config/stack_boat.yaml) lists the nodes:
         - {name: sim_node, package: dukw_sim, executable: sim_node, args: [-p, rate_hz:=100.0]}
 
 ``args`` are ROS arguments (after the parameter files), ``cli_args`` the program's
-own (before ``--ros-args``), ``rename: true`` runs the node under ``name``. A stack
+own (before ``--ros-args``), ``rename: true`` runs the node under ``name``.
+``composes: [ekf_node, ...]`` (with ``executable: compose``) runs those nodes in one
+process with one executor (dukw_bringup.compose; config/stack_sim_composed.yaml). A stack
 with ``clock_node: sim_node`` runs every other node with ``use_sim_time:=true``
 (as the launch file and the main job do), so stamps and ages share one clock.
 ``discovery_range: LOCALHOST`` (both stacks) keeps the ROS graph on the vehicle:
@@ -62,6 +64,12 @@ class NodeSpec:
     args: tuple[str, ...] = ()      # ROS arguments, after the parameter files
     rename: bool = False            # run under ``name`` (-r __node:=name), for a second instance
     cli_args: tuple[str, ...] = ()  # the program's own arguments, before --ros-args
+    composes: tuple[str, ...] = ()  # ROS nodes this process runs (compose); () = itself
+
+    @property
+    def node_names(self) -> tuple[str, ...]:
+        """The ROS nodes this process runs (their parameter blocks)."""
+        return self.composes or (self.name,)
 
 
 @dataclass(frozen=True)
@@ -76,6 +84,10 @@ class StackSpec:
     def uses_sim_time(self, spec: NodeSpec) -> bool:
         """Whether ``spec`` runs on the clock node's /clock."""
         return self.clock_node is not None and spec.name != self.clock_node
+
+    def node_names(self) -> list[str]:
+        """Every ROS node of the stack (a composed process's nodes one by one)."""
+        return [name for spec in self.nodes for name in spec.node_names]
 
     def node(self, name: str) -> NodeSpec:
         """The node called ``name``; KeyError if there is none."""
@@ -109,10 +121,14 @@ def parse_stack(doc: Any, source: str = 'stack') -> StackSpec:
                 raise ConfigError(f'{source}: stack.nodes[{i}].{key} must be a list of strings')
             lists[key] = tuple(str(a) for a in value)
         nodes.append(NodeSpec(raw['name'], raw['package'], raw['executable'], lists['args'],
-                              bool(raw.get('rename', False)), lists['cli_args']))
+                              bool(raw.get('rename', False)), lists['cli_args'],
+                              _composes(raw, f'{source}: stack.nodes[{i}]')))
     names = [n.name for n in nodes]
     if len(set(names)) != len(names):
         raise ConfigError(f'{source}: node names must be unique, got {names}')
+    ros_names = [name for n in nodes for name in n.node_names]
+    if len(set(ros_names)) != len(ros_names):
+        raise ConfigError(f'{source}: a node runs twice (composed and alone?): {ros_names}')
     clock_node = tree.get('clock_node')
     if clock_node is not None and clock_node not in names:
         raise ConfigError(f'{source}: stack.clock_node {clock_node!r} is not one of {names}')
@@ -122,6 +138,17 @@ def parse_stack(doc: Any, source: str = 'stack') -> StackSpec:
                           f'got {discovery!r}')
     return StackSpec(str(tree.get('name', Path(source).stem)), tuple(nodes), clock_node,
                      discovery)
+
+
+def _composes(raw: Mapping, where: str) -> tuple[str, ...]:
+    """A process's ``composes`` list (the nodes of one composed process), checked."""
+    value = raw.get('composes', [])
+    if not isinstance(value, list) or not all(
+            isinstance(n, str) and _NAME.match(n) for n in value):
+        raise ConfigError(f'{where}.composes must be a list of node names, got {value!r}')
+    if value and raw.get('rename'):
+        raise ConfigError(f'{where}: rename would rename every composed node; drop it')
+    return tuple(value)
 
 
 def load_stack(path: str | Path) -> StackSpec:
@@ -154,7 +181,7 @@ def node_command(spec: NodeSpec, params_files: Sequence[Path],
                  sim_time: bool = False, secure: bool = False) -> list[str]:
     """The command line that runs one node (``secure``: in its SROS2 enclave)."""
     command = [str(node_executable(spec.package, spec.executable)), *spec.cli_args,
-               '--ros-args']
+               *spec.composes, '--ros-args']
     if spec.rename:
         command += ['-r', f'__node:={spec.name}']
     if secure:

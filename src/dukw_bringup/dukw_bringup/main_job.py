@@ -4,7 +4,8 @@
 
 Creates the run folder (default runs/<UTC timestamp>/; see dukw_bringup.run_setup),
 starts the recorder (every topic to bag/, MCAP), the simulator stack
-(config/stack_sim.yaml) and the shore link (MAVLink 2 to a ground station on
+(config/stack_sim_composed.yaml, the control chain in one process; ``--stack sim``: one
+process per node) and the shore link (MAVLink 2 to a ground station on
 udpout:127.0.0.1:14550, signed with a key made for the run, outside the repository,
 whose file and passphrase are printed) through the bring-up runner, prints the mode changes and
 one progress line a second, and stops when the mission ends, the time limit
@@ -132,7 +133,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument('--mission', type=Path, help='mission file (default config/mission.yaml)')
     parser.add_argument('--params-file', type=Path,
                         help='parameter file (default config/dukw.yaml)')
-    parser.add_argument('--stack', default='sim', help='stack name or file (default sim)')
+    parser.add_argument('--stack', default='sim_composed',
+                        help='stack name or file (default sim_composed: the control chain in '
+                             'one process, the faster shape; sim: one process per node)')
     parser.add_argument('--rtf', type=float, default=1.0,
                         help='real-time factor of the simulator (0 = as fast as possible)')
     parser.add_argument('--waypoints', type=int, help='fly only the first N waypoints')

@@ -81,7 +81,7 @@ def write_overlay(path: Path, stack: StackSpec, spec: MissionSpec, mission_file:
                   real_time_factor: float, shore: ShoreSetup | None = None) -> Path:
     """Write the run's parameter overlay (a ROS 2 parameter file given after dukw.yaml)."""
     doc: dict[str, Any] = {}
-    for name in [n.name for n in stack.nodes] + [MONITOR]:
+    for name in stack.node_names() + [MONITOR]:
         if name == SIM_NODE:
             doc[name] = {'ros__parameters': sim_overrides(spec, real_time_factor)}
         else:

@@ -33,9 +33,41 @@ def test_workspace_stacks_parse():
         n.executable for n in boat.nodes}
 
 
+@pytest.mark.parametrize('shape', ['sim', 'boat'])
+def test_both_stack_shapes_load_with_the_same_nodes(shape):
+    """One process per node (sim, boat) and the control chain composed (sim_composed, the
+    main job's; boat_composed) run the same ROS nodes; the composed process lists its
+    nodes as arguments."""
+    from dukw_bringup.bringup import node_command
+    separate = load_stack(stack_path(shape))
+    composed = load_stack(stack_path(f'{shape}_composed'))
+    assert sorted(separate.node_names()) == sorted(composed.node_names())
+    assert all(not spec.composes for spec in separate.nodes)
+    chain = composed.node('control_chain')
+    assert {'ekf_node', 'mode_manager_node', 'drive_controller_node'} <= set(chain.composes)
+    assert len(composed.nodes) < len(separate.nodes)
+    command = node_command(chain, [Path('p.yaml')], composed.uses_sim_time(chain))
+    assert command[0].endswith('lib/dukw_bringup/compose')
+    ros_args = command.index('--ros-args')
+    assert command[1:ros_args] == list(chain.composes)
+    assert '__node:=' not in ' '.join(command)          # a rename would rename them all
+
+
+def test_the_run_overlay_puts_every_composed_node_on_sim_time(tmp_path):
+    from dukw_bringup.mission import load_mission
+    from dukw_bringup.run_setup import prepare_run
+    from dukw_common.config import default_config_path, load_file
+    stack = load_stack(stack_path('sim_composed'))
+    _, overlay = prepare_run(tmp_path, default_config_path(), stack, load_mission(), 1.0)
+    params = load_file(overlay)
+    for name in stack.node('control_chain').composes:
+        assert params[name]['use_sim_time'] is True, name
+
+
 def test_sim_stack_runs_every_node_but_the_simulator_on_sim_time():
     from dukw_bringup.bringup import node_command
-    for name, expected in (('sim', True), ('boat', False)):
+    for name, expected in (('sim', True), ('sim_composed', True), ('boat', False),
+                           ('boat_composed', False)):
         stack = load_stack(stack_path(name))
         for spec in stack.nodes:
             command = node_command(spec, [], stack.uses_sim_time(spec))
@@ -45,7 +77,7 @@ def test_sim_stack_runs_every_node_but_the_simulator_on_sim_time():
 
 def test_both_stacks_keep_the_ros_graph_on_the_vehicle_unless_told_otherwise():
     from dukw_bringup.bringup import DISCOVERY_ENV, Runner
-    for name in ('sim', 'boat'):
+    for name in ('sim', 'sim_composed', 'boat', 'boat_composed'):
         stack = load_stack(stack_path(name))
         assert Runner(stack, env={DISCOVERY_ENV: ''}).env[DISCOVERY_ENV] == 'LOCALHOST'
         assert Runner(stack, env={DISCOVERY_ENV: 'SUBNET'}).env[DISCOVERY_ENV] == 'SUBNET'
@@ -63,6 +95,13 @@ def test_both_stacks_keep_the_ros_graph_on_the_vehicle_unless_told_otherwise():
      'clock_node'),
     ({'stack': {'discovery_range': 'WORLD',
                 'nodes': [{'name': 'a', 'package': 'p', 'executable': 'e'}]}}, 'discovery_range'),
+    ({'stack': {'nodes': [{'name': 'a', 'package': 'p', 'executable': 'e',
+                           'composes': 'ekf_node'}]}}, 'composes'),
+    ({'stack': {'nodes': [{'name': 'a', 'package': 'p', 'executable': 'e', 'rename': True,
+                           'composes': ['ekf_node']}]}}, 'rename'),
+    ({'stack': {'nodes': [{'name': 'ekf_node', 'package': 'p', 'executable': 'e'},
+                          {'name': 'c', 'package': 'p', 'executable': 'e',
+                           'composes': ['ekf_node']}]}}, 'runs twice'),
 ])
 def test_bad_stack_file_is_refused(doc, message):
     with pytest.raises(ConfigError, match=message):

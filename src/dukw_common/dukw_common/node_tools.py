@@ -4,12 +4,13 @@ This is the only module of dukw_common that imports rclpy.
 """
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import sys
 import threading
 from dataclasses import dataclass
-from typing import Callable, Sequence
+from typing import Any, Callable, Collection, Mapping, Sequence
 
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
@@ -126,6 +127,17 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
     prints a clear message and exits 2. ``executor_factory`` may give another
     executor; every executor is spun with a timeout.
     """
+    return run_nodes(lambda: [factory()], args, executor_factory)
+
+
+def run_nodes(factory: Callable[[], Sequence[Node]], args: list[str] | None = None,
+              executor_factory: Callable[[], Executor] = default_executor) -> int:
+    """run_node for several nodes in one process, spun by ONE executor (a composed
+    bring-up, as a ROS 2 component container): ``factory()`` builds and wires them.
+
+    On the way out every node's ``on_shutdown()`` runs in reverse order of the list
+    (list the commanding node last: its neutral goes out first), then all are destroyed.
+    """
     try:
         check_params_files(sys.argv if args is None else args)
         rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
@@ -135,30 +147,75 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
     stop = threading.Event()
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: stop.set())
-    node = None
+    nodes: Sequence[Node] = ()
     code = 0
     try:
         try:
-            node = factory()
+            nodes = factory()
         except _rclpy.RCLError as exc:   # e.g. DDS-Security asked of a DDS without it
             raise ConfigError(f'cannot create the node: {exc}') from exc
         executor = executor_factory()
-        executor.add_node(node)
-        while not stop.is_set() and rclpy.ok():
-            executor.spin_once(timeout_sec=0.05)
+        for node in nodes:
+            executor.add_node(node)
+        with profiled(os.environ.get(PROFILE_ENV, '').format(
+                node=nodes[-1].get_name() if nodes else '', pid=os.getpid())):
+            while not stop.is_set() and rclpy.ok():
+                executor.spin_once(timeout_sec=0.05)
     except ExternalShutdownException:
         pass                     # the node ended itself (context.try_shutdown()): exit 0
     except ConfigError as exc:
         print(f'[FATAL] {exc}', file=sys.stderr)
         code = 2
     finally:
-        if node is not None:
-            shutdown_hook = getattr(node, 'on_shutdown', None)
-            if callable(shutdown_hook) and rclpy.ok():
-                shutdown_hook()
-            node.destroy_node()
-        rclpy.try_shutdown()
+        _shut_down(nodes)
     return code
+
+
+#: DUKW_PROFILE=FILE: profile the spin loop with cProfile, stats as text to FILE on exit;
+#: ``{node}`` in FILE is the (last) node's name, ``{pid}`` the process id
+PROFILE_ENV = 'DUKW_PROFILE'
+
+
+@contextlib.contextmanager
+def profiled(path: str | None):
+    """cProfile the block when ``path`` is given; write its top 40 (by own time) as text."""
+    if not path:
+        yield
+        return
+    import cProfile
+    import io
+    import pstats
+    profile = cProfile.Profile()
+    profile.enable()
+    try:
+        yield
+    finally:
+        profile.disable()
+        text = io.StringIO()
+        pstats.Stats(profile, stream=text).sort_stats('tottime').print_stats(40)
+        with open(path, 'w') as out:
+            out.write(text.getvalue())
+
+
+def _shut_down(nodes: Sequence[Node]) -> None:
+    """Each node's on_shutdown (reverse order, while the context is up), then destroy all."""
+    for node in reversed(nodes):
+        shutdown_hook = getattr(node, 'on_shutdown', None)
+        if callable(shutdown_hook) and rclpy.ok():
+            shutdown_hook()
+    for node in nodes:
+        node.destroy_node()
+    rclpy.try_shutdown()
+
+
+def subscribe_sensors(node: Node, inputs: Mapping[str, tuple[type, Callable[[Any], None]]],
+                      handed: Collection[str] = ()) -> None:
+    """Subscribe (sensor QoS) each of ``inputs`` (topic -> (type, callback)) but those in
+    ``handed``: a composed process (dukw_bringup.compose) subscribes those once itself and
+    hands each message to every node's callback, or hands over a core output directly."""
+    for topic, (msg_type, callback) in inputs.items():
+        if topic not in handed:
+            node.create_subscription(msg_type, topic, callback, SENSOR_QOS)
 
 
 def check_params_files(argv: Sequence[str]) -> None:

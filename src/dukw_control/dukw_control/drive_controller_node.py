@@ -4,6 +4,8 @@ A thin shell around dukw_control.runners.DriveControllerRunner (when to step) an
 dukw_control.controller.DriveController (what to command): it converts messages and
 publishes the commands (neutral on shutdown).
 """
+from typing import Collection
+
 from diagnostic_msgs.msg import DiagnosticArray
 from dukw_msgs.msg import Authority, DrivetrainStatus, DriveMode, Traction
 from nav_msgs.msg import Odometry
@@ -12,9 +14,9 @@ from sensor_msgs.msg import Imu
 
 from dukw_common.cmd_vel import CMD_VEL_STAMPED_SPEC, cmd_vel_type, read_cmd_vel
 from dukw_common.config import ConfigError
-from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
-                                    declare_parameters, diagnostic_array, publisher_sources,
-                                    run_node, vehicle_specs)
+from dukw_common.node_tools import (COMMAND_QOS, STATE_QOS, ParamSpec, declare_parameters,
+                                    diagnostic_array, publisher_sources, run_node,
+                                    subscribe_sensors, vehicle_specs)
 from dukw_control.controller import NODE_PARAMS, ControlOutput
 from dukw_control.convert import (ActuatorPublishers, authority_usable, decision_from_msg,
                                   pitch_from_quaternion, stamp_or)
@@ -24,8 +26,10 @@ from dukw_control.runners import DriveControllerRunner
 class DriveControllerNode(Node):
     """Subscribes the requests and the vehicle's state; publishes guarded commands."""
 
-    def __init__(self) -> None:
-        super().__init__('drive_controller_node')
+    def __init__(self, handed_topics: Collection[str] = (), **node_kwargs) -> None:
+        """``handed_topics``: inputs a composed process hands over (dukw_bringup.compose);
+        a handed drive_mode is still watched for a second source, its content ignored."""
+        super().__init__('drive_controller_node', **node_kwargs)
         specs = [ParamSpec(n, d, min=lo, max=hi) for n, d, lo, hi in NODE_PARAMS]
         specs.append(ParamSpec('step_on_odometry', 'run a control step on each estimate'))
         specs.append(CMD_VEL_STAMPED_SPEC)
@@ -41,12 +45,13 @@ class DriveControllerNode(Node):
         self.create_subscription(cmd_vel_type(params['cmd_vel_stamped']), 'cmd_vel',
                                  self.on_cmd_vel, COMMAND_QOS)
         self.create_subscription(Authority, 'authority', self.on_authority, STATE_QOS)
-        self.create_subscription(DriveMode, 'drive_mode', self.on_mode, STATE_QOS)
-        self.create_subscription(Odometry, 'odometry/filtered', self.on_odometry, SENSOR_QOS)
-        self.create_subscription(Imu, 'imu/data', self.on_imu, SENSOR_QOS)
-        self.create_subscription(Traction, 'traction', self.on_traction, SENSOR_QOS)
-        self.create_subscription(DrivetrainStatus, 'tracks/status', self.on_tracks, SENSOR_QOS)
-        self.create_subscription(DrivetrainStatus, 'props/status', self.on_props, SENSOR_QOS)
+        self.create_subscription(DriveMode, 'drive_mode', self.watch_mode_sources
+                                 if 'drive_mode' in handed_topics else self.on_mode, STATE_QOS)
+        self.inputs = {'odometry/filtered': (Odometry, self.on_odometry),
+                       'imu/data': (Imu, self.on_imu), 'traction': (Traction, self.on_traction),
+                       'tracks/status': (DrivetrainStatus, self.on_tracks),
+                       'props/status': (DrivetrainStatus, self.on_props)}
+        subscribe_sensors(self, self.inputs, handed_topics)
         self.props_connected = None
         self.last_reason = None
         self.create_timer(self.runner.period_s, self.on_tick)
@@ -68,8 +73,13 @@ class DriveControllerNode(Node):
         self.publish(self.runner.on_authority(*authority_usable(msg), self.now_s()))
 
     def on_mode(self, msg: DriveMode) -> None:
-        self.core.sources.update('drive_mode', *publisher_sources(self, 'drive_mode'))
+        self.watch_mode_sources(msg)
         self.runner.on_mode(decision_from_msg(msg), self.now_s())
+
+    def watch_mode_sources(self, msg: DriveMode) -> None:
+        """A second drive_mode publisher is a fault (neutral) even where the mode is handed
+        over in-process: the rule of one source holds in both bring-up shapes."""
+        self.core.sources.update('drive_mode', *publisher_sources(self, 'drive_mode'))
 
     def on_odometry(self, msg: Odometry) -> None:
         self.publish(self.runner.on_odometry(

@@ -5,6 +5,8 @@ transient local, on every change with its reason and every ``republish_period_s`
 dukw_control.modes.ModeManager (the decision); the service ``set_mode`` forces a mode
 or returns to automatic.
 """
+from typing import Callable, Collection
+
 from diagnostic_msgs.msg import DiagnosticArray
 from dukw_msgs.msg import Depth, DrivetrainStatus, DriveMode, Traction, WaterContact
 from dukw_msgs.srv import SetMode
@@ -14,19 +16,20 @@ from sensor_msgs.msg import Imu
 from dukw_common.config import ConfigError
 from dukw_common.diagnostics import Health, Level
 from dukw_common.sources import SourceWatch
-from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
-                                    declare_parameters, diagnostic_array, refuse_second_client,
-                                    run_node)
+from dukw_common.node_tools import (COMMAND_QOS, STATE_QOS, ParamSpec, declare_parameters,
+                                    diagnostic_array, refuse_second_client, run_node,
+                                    subscribe_sensors)
 from dukw_control.convert import decision_to_msg, stamp_or
-from dukw_control.modes import NODE_PARAMS, Mode
+from dukw_control.modes import NODE_PARAMS, Mode, ModeDecision
 from dukw_control.runners import ModeManagerRunner
 
 
 class ModeManagerNode(Node):
     """Feeds the state machine and publishes its decisions."""
 
-    def __init__(self) -> None:
-        super().__init__('mode_manager_node')
+    def __init__(self, handed_topics: Collection[str] = (), **node_kwargs) -> None:
+        """``handed_topics``: inputs a composed process hands over (dukw_bringup.compose)."""
+        super().__init__('mode_manager_node', **node_kwargs)
         specs = [ParamSpec(n, d, min=lo, max=hi) for n, d, lo, hi in NODE_PARAMS]
         params = declare_parameters(self, specs)
         try:
@@ -37,11 +40,13 @@ class ModeManagerNode(Node):
         self.sources = SourceWatch()          # set_mode: one client, the operator's
         self.mode_pub = self.create_publisher(DriveMode, 'drive_mode', STATE_QOS)
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
-        self.create_subscription(WaterContact, 'water/contact', self.on_contact, SENSOR_QOS)
-        self.create_subscription(Depth, 'depth', self.on_depth, SENSOR_QOS)
-        self.create_subscription(Traction, 'traction', self.on_traction, SENSOR_QOS)
-        self.create_subscription(DrivetrainStatus, 'tracks/status', self.on_tracks, SENSOR_QOS)
-        self.create_subscription(Imu, 'imu/data', self.on_imu, SENSOR_QOS)
+        self.inputs = {'water/contact': (WaterContact, self.on_contact),
+                       'depth': (Depth, self.on_depth), 'traction': (Traction, self.on_traction),
+                       'tracks/status': (DrivetrainStatus, self.on_tracks),
+                       'imu/data': (Imu, self.on_imu)}
+        subscribe_sensors(self, self.inputs, handed_topics)
+        #: called with each published decision (a composed process's direct hand-off)
+        self.decision_listeners: list[Callable[[ModeDecision], None]] = []
         self.create_service(SetMode, 'set_mode', self.on_set_mode)
         self.create_timer(1.0 / self.runner.rate_hz, self.on_timer)
         self.create_timer(1.0, self.publish_diagnostics)
@@ -97,6 +102,8 @@ class ModeManagerNode(Node):
         if publication.changed:
             self.get_logger().info(f'drive mode {decision.mode.name}: {decision.reason}')
         self.mode_pub.publish(decision_to_msg(decision, self.get_clock().now().to_msg()))
+        for listen in self.decision_listeners:
+            listen(decision)
 
     def publish_diagnostics(self) -> None:
         now = self.now_s()

@@ -8,6 +8,8 @@ dukw_estimation.runner's, the estimation dukw_estimation.estimator's.
 """
 from __future__ import annotations
 
+from typing import Callable, Collection
+
 from diagnostic_msgs.msg import DiagnosticArray
 from dukw_msgs.msg import Depth, DrivetrainStatus, Traction, WaterContact
 from dukw_msgs.srv import SetPose
@@ -19,9 +21,10 @@ from tf2_msgs.msg import TFMessage
 
 from dukw_common.config import node_params, section
 from dukw_common.diagnostics import Health, Level
-from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, ParamSpec, declare_parameters,
+from dukw_common.node_tools import (COMMAND_QOS, ParamSpec, declare_parameters,
                                     diagnostic_array, refuse_second_client, run_node,
-                                    s_to_stamp, vehicle_specs)
+                                    s_to_stamp, subscribe_sensors, vehicle_specs)
+from dukw_common.rates import Decimator
 from dukw_common.sources import SourceWatch
 from dukw_common.tf_tools import TF_QOS, odometry_tf
 from dukw_estimation import ros_convert as conv
@@ -34,13 +37,16 @@ DIAGNOSTICS_PERIOD_S = 1.0
 class EkfNode(Node):
     """Thin shell around EkfRunner: messages in, estimates out."""
 
-    def __init__(self, **node_kwargs) -> None:
+    def __init__(self, handed_topics: Collection[str] = (), **node_kwargs) -> None:
+        """``handed_topics``: inputs a composed process hands over (dukw_bringup.compose)."""
         super().__init__('ekf_node', **node_kwargs)
         specs = [ParamSpec(n, d, min=lo, max=hi) for n, d, lo, hi in setting_specs()]
         specs += vehicle_specs()
         specs.append(ParamSpec('publish_on_imu', 'publish after each IMU sample, not only on '
                                'the timer'))
         specs.append(ParamSpec('publish_tf', 'broadcast odom -> base_link on /tf'))
+        specs += [ParamSpec(f'{name}_rate_hz', f'most {name} messages a second (observers)',
+                            min=0.1, max=1000.0) for name in ('tf', 'traction')]
         specs += [ParamSpec(f'soil_presets.{name}', 'soil preset value (vehicle.md 6)', min=0.0)
                   for name in section(node_params('ekf_node'), 'soil_presets')
                   if name != 'names']
@@ -53,12 +59,15 @@ class EkfNode(Node):
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
         self.tf_pub = (self.create_publisher(TFMessage, '/tf', TF_QOS)
                        if params['publish_tf'] else None)
-        for msg_type, topic in ((Imu, 'imu/data'), (NavSatFix, 'gps/fix'),
-                                (TwistWithCovarianceStamped, 'gps/vel'),
-                                (WaterContact, 'water/contact'), (Depth, 'depth'),
-                                (DrivetrainStatus, 'tracks/status'),
-                                (DrivetrainStatus, 'props/status')):
-            self.create_subscription(msg_type, topic, self._handler(topic), SENSOR_QOS)
+        self.tf_due = Decimator(params['tf_rate_hz']).due
+        self.traction_due = Decimator(params['traction_rate_hz']).due
+        self.inputs = {topic: (msg_type, self._handler(topic)) for msg_type, topic in (
+            (Imu, 'imu/data'), (NavSatFix, 'gps/fix'), (TwistWithCovarianceStamped, 'gps/vel'),
+            (WaterContact, 'water/contact'), (Depth, 'depth'),
+            (DrivetrainStatus, 'tracks/status'), (DrivetrainStatus, 'props/status'))}
+        subscribe_sensors(self, self.inputs, handed_topics)
+        #: called with each published estimate (a composed process's direct hand-off)
+        self.estimate_listeners: list[Callable[[Estimate], None]] = []
         self.create_service(SetPose, 'set_pose', self._on_set_pose)
         self.create_timer(1.0 / self.runner.rate_hz, self._on_timer)
         self.create_timer(DIAGNOSTICS_PERIOD_S, self._on_diagnostics)
@@ -84,9 +93,12 @@ class EkfNode(Node):
         stamp = s_to_stamp(estimate.t_s)
         odom = conv.odometry_msg(estimate.odometry, stamp, 'odom', 'base_link')
         self.odom_pub.publish(odom)
-        if self.tf_pub is not None:
+        for listen in self.estimate_listeners:   # in-process consumers (commands) first
+            listen(estimate)
+        if self.tf_pub is not None and self.tf_due(estimate.t_s):
             self.tf_pub.publish(odometry_tf(odom))
-        self.traction_pub.publish(conv.traction_msg(estimate.traction, stamp, Traction))
+        if self.traction_due(estimate.t_s):
+            self.traction_pub.publish(conv.traction_msg(estimate.traction, stamp, Traction))
 
     def _on_diagnostics(self) -> None:
         healths = self.estimator.health(self._now_s())

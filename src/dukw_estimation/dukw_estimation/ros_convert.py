@@ -119,10 +119,10 @@ def odometry_msg(est: OdometryEstimate, stamp, frame_id: str, child_frame_id: st
     pose.position.x, pose.position.y, pose.position.z = est.x_m, est.y_m, est.z_m
     q = quaternion_from_euler(est.roll_rad, est.pitch_rad, est.yaw_rad)
     pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w = q
-    msg.pose.covariance = [float(v) for v in np.asarray(est.pose_cov).ravel()]
+    msg.pose.covariance = np.asarray(est.pose_cov, dtype=np.float64).ravel()  # no per-item check
     tw = msg.twist.twist
     tw.linear.x, tw.linear.y, tw.angular.z = est.surge_mps, est.sway_mps, est.yaw_rate_rps
-    msg.twist.covariance = [float(v) for v in np.asarray(est.twist_cov).ravel()]
+    msg.twist.covariance = np.asarray(est.twist_cov, dtype=np.float64).ravel()
     return msg
 
 
