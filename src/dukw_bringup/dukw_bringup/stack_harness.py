@@ -211,8 +211,10 @@ class Stack:
     def _publish_estimate(self, t_ns: int, estimate: Estimate) -> None:
         self.estimate = estimate
         self.publish('odometry/filtered', t_ns, estimate.odometry)
-        self.publish('traction', t_ns + 1_000, estimate.traction)
-        self.publish('tf', t_ns + 2_000, estimate.odometry)
+        if estimate.traction_due:
+            self.publish('traction', t_ns + 1_000, estimate.traction)
+        if estimate.tf_due:
+            self.publish('tf', t_ns + 2_000, estimate.odometry)
 
     # --- one step ------------------------------------------------------------------------
     def step(self, cmd_vel: tuple[float, float] | None = None) -> Truth:

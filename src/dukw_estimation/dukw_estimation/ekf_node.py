@@ -24,7 +24,6 @@ from dukw_common.diagnostics import Health, Level
 from dukw_common.node_tools import (COMMAND_QOS, ParamSpec, declare_parameters,
                                     diagnostic_array, refuse_second_client, run_node,
                                     s_to_stamp, subscribe_sensors, vehicle_specs)
-from dukw_common.rates import Decimator
 from dukw_common.sources import SourceWatch
 from dukw_common.tf_tools import TF_QOS, odometry_tf
 from dukw_estimation import ros_convert as conv
@@ -59,8 +58,6 @@ class EkfNode(Node):
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
         self.tf_pub = (self.create_publisher(TFMessage, '/tf', TF_QOS)
                        if params['publish_tf'] else None)
-        self.tf_due = Decimator(params['tf_rate_hz']).due
-        self.traction_due = Decimator(params['traction_rate_hz']).due
         self.inputs = {topic: (msg_type, self._handler(topic)) for msg_type, topic in (
             (Imu, 'imu/data'), (NavSatFix, 'gps/fix'), (TwistWithCovarianceStamped, 'gps/vel'),
             (WaterContact, 'water/contact'), (Depth, 'depth'),
@@ -95,9 +92,9 @@ class EkfNode(Node):
         self.odom_pub.publish(odom)
         for listen in self.estimate_listeners:   # in-process consumers (commands) first
             listen(estimate)
-        if self.tf_pub is not None and self.tf_due(estimate.t_s):
+        if self.tf_pub is not None and estimate.tf_due:
             self.tf_pub.publish(odometry_tf(odom))
-        if self.traction_due(estimate.t_s):
+        if estimate.traction_due:
             self.traction_pub.publish(conv.traction_msg(estimate.traction, stamp, Traction))
 
     def _on_diagnostics(self) -> None:

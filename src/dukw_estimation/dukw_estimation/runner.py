@@ -5,6 +5,8 @@ in-process stack harness (dukw_bringup.stack_harness) all drive this runner, so 
 estimator's timing rule lives here and nowhere else:
 
 - every sensor sample goes to the estimator as it arrives;
+- odometry/filtered goes out with every estimate; /tf and traction at most
+  ``tf_rate_hz`` / ``traction_rate_hz`` (their readers need less: README "Topic contract");
 - with ``publish_on_imu`` the estimate goes out after each IMU sample (the IMU's rate is
   the output rate: the controller steps on it), and the ``rate_hz`` timer publishes only
   while the IMU has been silent for 1.5 periods, predicting to the present but never
@@ -19,6 +21,7 @@ from dataclasses import dataclass
 from typing import Any, Mapping
 
 from dukw_common.config import ParamValue
+from dukw_common.rates import Decimator
 from dukw_common.vehicle import Vehicle, soil_params
 from dukw_estimation.estimator import Estimator
 from dukw_estimation.samples import OdometryEstimate, TractionEstimate
@@ -35,10 +38,13 @@ INPUTS = {'imu/data': 'add_imu', 'gps/fix': 'add_gps_fix', 'gps/vel': 'add_gps_v
 
 @dataclass(frozen=True)
 class Estimate:
-    """What ekf_node publishes at once: odometry/filtered (and /tf) and traction."""
+    """What ekf_node publishes at once: odometry/filtered always; /tf and traction when
+    their observers' rates (``tf_rate_hz``, ``traction_rate_hz``) say so."""
 
     odometry: OdometryEstimate
     traction: TractionEstimate
+    tf_due: bool = True
+    traction_due: bool = True
 
     @property
     def t_s(self) -> float:
@@ -49,7 +55,9 @@ class EkfRunner:
     """ekf_node's schedule around dukw_estimation.estimator.Estimator."""
 
     def __init__(self, estimator: Estimator, settings: EkfSettings,
-                 publish_on_imu: bool) -> None:
+                 publish_on_imu: bool, tf_rate_hz: float | None = None,
+                 traction_rate_hz: float | None = None) -> None:
+        """A rate None: with every estimate."""
         self.estimator = estimator
         self.settings = settings
         self.rate_hz = float(settings.rate_hz)
@@ -57,6 +65,8 @@ class EkfRunner:
         self.publish_on_imu = bool(publish_on_imu)
         self.last_event_publish_s = -float('inf')
         self._routes = {topic: getattr(estimator, name) for topic, name in INPUTS.items()}
+        self._tf_due = Decimator(tf_rate_hz).due if tf_rate_hz else None
+        self._traction_due = Decimator(traction_rate_hz).due if traction_rate_hz else None
 
     @classmethod
     def from_params(cls, params: Mapping[str, ParamValue], vehicle: Vehicle | None = None,
@@ -66,7 +76,8 @@ class EkfRunner:
         settings = settings or EkfSettings.from_params(params)
         estimator = Estimator(vehicle or Vehicle.from_params(params), settings,
                               soil_params(params, settings.soil_preset or None))
-        return cls(estimator, settings, bool(params.get('publish_on_imu', False)))
+        return cls(estimator, settings, bool(params.get('publish_on_imu', False)),
+                   params.get('tf_rate_hz'), params.get('traction_rate_hz'))
 
     def on_sample(self, topic: str, sample: Any, now_s: float) -> Estimate | None:
         """A converted sample of subscribed ``topic``; the estimate when it goes out now."""
@@ -77,7 +88,7 @@ class EkfRunner:
         if topic != 'imu/data' or not self.publish_on_imu or self.estimator.t_s is None:
             return None
         self.last_event_publish_s = now_s
-        return self.estimate()
+        return self._publication()
 
     def tick(self, now_s: float) -> Estimate | None:
         """The timer: publish only while the IMU is silent (and once something arrived)."""
@@ -86,7 +97,14 @@ class EkfRunner:
             return None
         if 0.0 < now_s - est.t_s <= self.settings.sensor_timeout_s:
             est.advance(now_s)       # predict to the present, never further than a timeout
-        return self.estimate()
+        return self._publication()
+
+    def _publication(self) -> Estimate:
+        odometry = self.estimator.odometry()
+        t_s = odometry.t_s
+        return Estimate(odometry, self.estimator.traction(),
+                        self._tf_due is None or self._tf_due(t_s),
+                        self._traction_due is None or self._traction_due(t_s))
 
     def estimate(self) -> Estimate:
         """The current estimate (pure: asking changes nothing)."""
