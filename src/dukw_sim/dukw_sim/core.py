@@ -407,7 +407,7 @@ class SimCore:
 
     def _wave_moments(self, areas: np.ndarray, water, yaw_cs: tuple) -> WaveMoments:
         """The strips' wave moments (waves.moments.strip_moments), else none."""
-        if not self.params.wave_moments.strip_moments:
+        if not self.params.wave_moments.strip_moments or self.world.calm:
             return self._no_moments
         return wave_moments(self.world.calm, areas, self.hull.strip_length_m, water,
                             self.params.waves, self.vehicle.body.water_density_kgpm3,

@@ -304,3 +304,19 @@ def test_estimator_heave_mass_and_damping_are_the_simulators():
     assert est.heave_mass_kg == pytest.approx(sim.seakeeping.heave_mass_kg, rel=1e-9)
     assert est.heave_damping_n_per_mps == pytest.approx(
         sim.seakeeping.heave_damping_n_per_mps, rel=1e-9)
+
+
+
+def _drift_yaw_rate_rms_dps(strip_moments: bool) -> float:
+    sim = SimCore.from_config(overrides={'waves.model': 'irregular',
+                                         'waves.moments.strip_moments': strip_moments}, seed=3)
+    sim.reset('afloat', yaw_rad=math.pi)
+    rates = [sim.step(Actuation()).yaw_rate_rps for _ in range(2500)]
+    return math.degrees(float(np.sqrt(np.mean(np.square(rates[500:])))))
+
+
+def test_a_short_crested_sea_yaws_a_drifting_vehicle_through_the_strip_moments():
+    # issue 13: the boat drifting in the surf yawed (RMS 6 deg/s); with only the total wave
+    # force a symmetric vehicle never yaws, whatever the sea
+    assert _drift_yaw_rate_rms_dps(strip_moments=False) < 1e-6
+    assert _drift_yaw_rate_rms_dps(strip_moments=True) > 0.3
