@@ -298,9 +298,14 @@ def test_estimator_heave_mass_and_damping_are_the_simulators():
     """One hull model: the estimator's afloat volume from the heave acceleration uses the
     heave mass the simulator's hull is calibrated to (it used the bare 0.89 m^2 waterplane,
     9 % lighter)."""
-    from dukw_estimation.evaluate import build_estimator
+    from dukw_common.config import node_params
+    from dukw_common.vehicle import Vehicle, soil_params
+    from dukw_estimation.estimator import Estimator
+    from dukw_estimation.settings import EkfSettings
     sim = SimCore.from_config()
-    est = build_estimator(sim.vehicle, (0.0, 0.0, 0.0))
+    params = node_params('ekf_node')
+    est = Estimator(Vehicle.from_params(params), EkfSettings.from_params(params),
+                    soil_params(params)).contact
     assert est.heave_mass_kg == pytest.approx(sim.seakeeping.heave_mass_kg, rel=1e-9)
     assert est.heave_damping_n_per_mps == pytest.approx(
         sim.seakeeping.heave_damping_n_per_mps, rel=1e-9)
