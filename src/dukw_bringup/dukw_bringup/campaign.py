@@ -250,7 +250,9 @@ def sim_overrides(cond: Mapping[str, Any]) -> dict:
     out = {'waves.model': 'irregular' if height > 0.0 else 'none',
            'waves.significant_height_m': max(height, 1e-3),
            'waves.peak_period_s': cond['peak_period_s'],
-           'waves.spreading_rad': cond['spreading_rad'],
+           # the campaign draws the uniform spread: it replaces the default cos-2s one
+           'waves.spreading_rad': cond['spreading_rad'], 'waves.spreading_exponent_s': 0.0,
+           'waves.directions': 1,
            'site.beach_slope_rad': math.radians(cond['beach_slope_deg']),
            'soil.cohesion_pa': cond['cohesion_kpa'] * 1000.0,
            'soil.friction_angle_rad': math.radians(cond['friction_angle_deg']),

@@ -404,11 +404,13 @@ def _heaving_afloat(est, seconds=12.0, amplitude_m=0.1, hz=0.3):
 
 
 def test_afloat_volume_counts_the_heave_damping_force():
-    """Heaving 10 cm at 0.3 Hz the damping force is ~100 N (3 % of the displacement); the
-    volume from the IMU accounts for it through the integrated heave velocity."""
-    with_damping = _heaving_afloat(make())
+    """Heaving 10 cm at 0.3 Hz with damping ratio 0.1 the damping force is ~100 N (3 % of
+    the displacement); the volume from the IMU accounts for it through the integrated heave
+    velocity."""
+    with_damping = _heaving_afloat(make(heave_damping_ratio=0.1))
     assert with_damping < 0.01
-    assert _heaving_afloat(make(heave_velocity_tau_s=0.1)) > 2 * with_damping
+    assert _heaving_afloat(make(heave_damping_ratio=0.1, heave_velocity_tau_s=0.1)) \
+        > 2 * with_damping
 
 
 def _surf_samples():

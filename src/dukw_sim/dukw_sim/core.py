@@ -29,11 +29,11 @@ from dukw_common.vehicle import SoilParams, Vehicle
 from dukw_model import traction
 from dukw_model.propeller import prop_thrust_n, propeller_thrust_factor
 
-from dukw_sim.forces import (LATERAL_POINTS, BodyForces, Immersion, WaveForcing,
+from dukw_sim.forces import (LATERAL_POINTS, BodyForces, Immersion, WaveForcing, WaveMoments,
                              drivetrain_friction_n, hydrodynamic_drag, immersion,
                              lateral_resistance, odom_force, paddle_wrench, propulsion,
-                             rolling_resistance, slope_gravity, sum_wrenches, track_paddle_n,
-                             wave_forcing)
+                             rolling_resistance, slope_gravity, sum_wrenches, surf_resistance,
+                             track_paddle_n, track_wetness, wave_forcing, wave_moments)
 from dukw_sim.hull import HullGeometry, Seakeeping
 from dukw_sim.land import TrackContact, TrackLinear, linearise, motor_limited_speed
 from dukw_sim.params import SimParams, apply_overrides
@@ -171,6 +171,10 @@ class SimCore:
                                       [0.0, 0.0, 0.0, 0.0, self._half_sep, -self._half_sep]])
         self._lat_s = [self._track_len * ((j + 0.5) / LATERAL_POINTS - 0.5)
                        for j in range(LATERAL_POINTS)]
+        # strips over the tracks' contact length: where the surf wets the tracks
+        self._track_strips = np.abs(self.hull.station_x_m) <= self._track_len / 2.0
+        self._wave_lever_z = params.wave_moments.transverse_force_z_m - self._kg
+        self._no_moments = WaveMoments(0.0, 0.0, 0.0)
         self._external = (0.0, 0.0, 0.0)
         self._hydro_key = None
         self._hydro_val = None
@@ -319,12 +323,14 @@ class SimCore:
         u_rel, v_rel = u0 - uw, v0 - vw
         drives = self._track_drives(act, u_rel, w_eff, depths)
         thrust = self._thrust_n(act, water.elevation_m)
-        forces = self._body_forces(drives, imm, waves, thrust, w_eff, (u_rel, v_rel), (c, s))
+        moments = self._wave_moments(areas, water, (c, s))
+        forces = self._body_forces(drives, imm, waves, thrust, w_eff, (u_rel, v_rel), (c, s),
+                                   moments.yaw_nm)
         tracks = self._integrate_plane(forces, drives, imm.fraction, (c, s))
         if self.in_contact:
             self._follow_ground()
         else:
-            self._float_free(imm)
+            self._float_free(imm, moments)
         self.t_s += dt
         accel = ((self.u - u0) / dt - self.r * self.v, (self.v - v0) / dt + self.r * self.u,
                  (self.heave_vel - hv0) / dt)
@@ -396,9 +402,25 @@ class SimCore:
         return [prop_thrust_n(act.port_prop_pct, drive) * prop_share[0],
                 prop_thrust_n(act.stbd_prop_pct, drive) * prop_share[1]]
 
+    def _wave_moments(self, areas: np.ndarray, water, yaw_cs: tuple) -> WaveMoments:
+        """The strips' wave moments (waves.moments.strip_moments), else none."""
+        if not self.params.wave_moments.strip_moments or self.world.calm:
+            return self._no_moments
+        return wave_moments(self.world.calm, areas, self.hull.strip_length_m, water,
+                            self.params.waves, self.vehicle.body.water_density_kgpm3,
+                            self.hull.station_x_m, self.hull.station_y_m, yaw_cs,
+                            self._wave_lever_z)
+
+    def _track_wetness(self) -> float:
+        """Share of the tracks' height under the surface (over the contact length), 0..1."""
+        px, water = self._hydro()[:2]
+        n = self._n_stations
+        over = (water.elevation_m[:n] - self.world.beach.heights_m(px[:n]))[self._track_strips]
+        return track_wetness(over, self.vehicle.body.hull_clearance_m)
+
     def _body_forces(self, drives: _Drives, imm: Immersion, waves: WaveForcing,
                      thrust: list[float], w_eff: float, rel_water: tuple,
-                     yaw_cs: tuple) -> BodyForces:
+                     yaw_cs: tuple, wave_yaw_nm: float = 0.0) -> BodyForces:
         """Every horizontal force in body axes but the tracks' soil forces (those go into the
         implicit solve), summed by effect in one place. A new force is one more term here."""
         land, wat, half = self.params.land, self.params.water, self._half_sep
@@ -409,10 +431,14 @@ class SimCore:
             terms += lateral_resistance(w_eff, self.v, self.r, self._lat_s, land, self._weight)
             terms += slope_gravity(self._weight, imm.buoyancy_n,
                                    self.world.beach.gradient(self.x), c, s)
+            if self.params.surf.wet_motion_resistance_coeff > 0.0:
+                terms += surf_resistance(w_eff, self._track_wetness(), drives.ground,
+                                         self.params.surf, half)
         terms += propulsion(thrust, wat.prop_walk_ratio, self.params.propeller.x_m, half)
         terms.append(hydrodynamic_drag(rel_water[0], rel_water[1], self.r, imm.fraction, wat))
         ex, ey, en = self._external
-        terms.append(odom_force(waves.fx_n + ex, waves.fy_n + ey, en, c, s))
+        terms.append(odom_force(waves.fx_n + ex, waves.fy_n + ey,
+                                en + wave_yaw_nm if wave_yaw_nm else en, c, s))
         return sum_wrenches(terms)
 
     def _integrate_plane(self, forces: BodyForces, drives: _Drives, frac: float,
@@ -486,13 +512,17 @@ class SimCore:
         self.pitch_rate = (npitch - self.pitch) / dt
         self.z_cg, self.pitch, self.roll = nz, npitch, nroll
 
-    def _float_free(self, imm: Immersion) -> None:
-        """Afloat: heave, roll and pitch under the strips' buoyancy, with damping scaled by
-        the submerged share, then touch down if a track end reaches the sand."""
+    def _float_free(self, imm: Immersion, waves: WaveMoments) -> None:
+        """Afloat: heave, roll and pitch under the strips' buoyancy (and the waves' strip
+        moments), with damping scaled by the submerged share, then touch down if a track end
+        reaches the sand."""
         dt, sk, frac = self.dt_s, self.seakeeping, imm.fraction
         strip_f = imm.strip_force_n
         m_roll = float(strip_f @ self.hull.station_y_m)
         m_pitch = -float(strip_f @ self.hull.station_x_m)
+        if waves is not self._no_moments:
+            m_roll += waves.roll_nm
+            m_pitch += waves.pitch_nm
         self.heave_vel += dt * (imm.buoyancy_n - self._weight - sk.heave_damping_n_per_mps
                                 * self.heave_vel * frac) / sk.heave_mass_kg
         self.roll_rate += dt * (m_roll - sk.roll_damping_nm_per_rps

@@ -17,7 +17,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from dukw_sim.params import LandParams, WaterParams, WaveParams
+from dukw_sim.params import LandParams, MooringParams, SurfParams, WaterParams, WaveParams
 from dukw_sim.world import WaterSample
 
 _ROLL_EPS_MPS = 0.005          # regularisation of Coulomb rolling resistance
@@ -118,6 +118,80 @@ def wave_forcing(calm: bool, areas_m2: np.ndarray, strip_length_m: float, water:
     return WaveForcing(fwx, fwy, wu, wv)
 
 
+class WaveMoments(NamedTuple):
+    """Moments about the centre of gravity of the strips' wave forces: yaw (odom z), roll and
+    pitch (body x, y), N m."""
+
+    yaw_nm: float
+    roll_nm: float
+    pitch_nm: float
+
+
+def wave_moments(calm: bool, areas_m2: np.ndarray, strip_length_m: float, water: WaterSample,
+                 waves: WaveParams, rho_kgpm3: float, station_x_m: np.ndarray,
+                 station_y_m: np.ndarray, yaw_cs: tuple, lever_z_m: float) -> WaveMoments:
+    """Each strip's Froude-Krylov + diffraction force C_m rho V a (as ``wave_forcing``)
+    acting at the strip: its horizontal offset from the centre of gravity gives the yaw
+    moment, its height ``lever_z_m`` relative to it (< 0: below) the roll and pitch moments.
+    In a short-crested sea the transverse acceleration differs along the hulls, so the yaw
+    moment does not vanish with the vehicle's symmetry."""
+    if calm:
+        return WaveMoments(0.0, 0.0, 0.0)
+    c, s = yaw_cs
+    cm_v = waves.surge_inertia_coeff * rho_kgpm3 * areas_m2 * strip_length_m
+    fx = cm_v * water.accel_x_mps2          # odom
+    fy = cm_v * water.accel_y_mps2
+    off_x = c * station_x_m - s * station_y_m
+    off_y = s * station_x_m + c * station_y_m
+    yaw = float(off_x @ fy - off_y @ fx)
+    fx_body = c * float(fx.sum()) + s * float(fy.sum())
+    fy_body = -s * float(fx.sum()) + c * float(fy.sum())
+    # REP 103: a force to port below the centre of gravity lifts the port side (+ roll); a
+    # force forward below it lifts the bow (- pitch)
+    return WaveMoments(yaw, -lever_z_m * fy_body, lever_z_m * fx_body)
+
+
+def track_wetness(water_over_ground_m: np.ndarray, track_height_m: float) -> float:
+    """Share of the tracks' height under water, 0 (dry sand) .. 1 (the tracks covered),
+    mean of the given points along the tracks."""
+    if water_over_ground_m.size == 0:
+        return 0.0
+    return float(np.mean(np.clip(water_over_ground_m / track_height_m, 0.0, 1.0)))
+
+
+def surf_resistance(w_eff_n: float, wetness: float, ground_mps: tuple, surf: SurfParams,
+                    half_sep_m: float) -> list[Wrench]:
+    """Motion resistance of the wet, partly liquefied sand under the surf (sinkage and
+    bulldozing), a Coulomb resistance growing with the weight on the tracks and with the
+    share of the tracks under water, bounded by the tow tests' largest resistance."""
+    total_n = min(surf.wet_motion_resistance_coeff * wetness * w_eff_n, surf.max_resistance_n)
+    if total_n <= 0.0:
+        return []
+    return _coulomb_per_track(total_n / 2.0, ground_mps, half_sep_m)
+
+
+def mooring_force(stiffness_n_per_m: float, damping_n_per_mps: float, offset_m: tuple,
+                  velocity_mps: tuple, lever_m: tuple) -> tuple[float, float, float]:
+    """A line held at a point of the vehicle (a spring and a damper to a fixed anchor):
+    force in odom at that point's offset and velocity, and its yaw moment about the centre
+    of gravity (lever = the point's odom offset from it). Returns (fx, fy, moment)."""
+    fx = -stiffness_n_per_m * offset_m[0] - damping_n_per_mps * velocity_mps[0]
+    fy = -stiffness_n_per_m * offset_m[1] - damping_n_per_mps * velocity_mps[1]
+    return fx, fy, lever_m[0] * fy - lever_m[1] * fx
+
+
+def mooring(moor: MooringParams, x_m: float, y_m: float, yaw_rad: float, u_mps: float,
+            v_mps: float, r_rps: float, anchor: tuple) -> tuple[float, float, float]:
+    """The mooring line's force on a vehicle at this pose and speed (body u, v, r), with the
+    anchor where the attachment point started; (fx, fy) odom and yaw moment."""
+    c, s = math.cos(yaw_rad), math.sin(yaw_rad)
+    lever = (c * moor.attach_x_m, s * moor.attach_x_m)
+    point = (x_m + lever[0], y_m + lever[1])
+    vel = (c * u_mps - s * v_mps - r_rps * lever[1], s * u_mps + c * v_mps + r_rps * lever[0])
+    return mooring_force(moor.stiffness_n_per_m, moor.damping_n_per_mps,
+                         (point[0] - anchor[0], point[1] - anchor[1]), vel, lever)
+
+
 def drivetrain_friction_n(friction_n: float, track_speed_mps: float, ref_mps: float,
                           breakaway_ratio: float) -> float:
     """Friction of one track's drivetrain (breakaway near standstill), against the reference."""
@@ -145,7 +219,12 @@ def paddle_wrench(paddle_n: list[float], half_sep_m: float) -> Wrench:
 def rolling_resistance(w_eff_n: float, ground_mps: tuple, land: LandParams,
                        half_sep_m: float) -> list[Wrench]:
     """Coulomb rolling resistance of each track (regularised), port then starboard."""
-    roll_n = land.rolling_resistance_coeff * w_eff_n / 2.0
+    return _coulomb_per_track(land.rolling_resistance_coeff * w_eff_n / 2.0, ground_mps,
+                              half_sep_m)
+
+
+def _coulomb_per_track(roll_n: float, ground_mps: tuple, half_sep_m: float) -> list[Wrench]:
+    """A Coulomb resistance of ``roll_n`` on each track against its ground speed."""
     out = []
     for i, sign in ((0, -1.0), (1, 1.0)):
         th = math.tanh(ground_mps[i] / _ROLL_EPS_MPS)

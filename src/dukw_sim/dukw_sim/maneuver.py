@@ -25,6 +25,7 @@ import numpy as np
 
 from dukw_common.config import ConfigError
 from dukw_sim.core import Actuation, SimCore
+from dukw_sim.forces import mooring
 from dukw_sim.truth import Medium, Truth
 
 #: CSV columns: name and how it comes from a Truth (issue 3's list first).
@@ -54,8 +55,6 @@ CSV_COLUMNS: list[tuple[str, Callable[[Truth], float]]] = [
 
 _INCLINE_LENGTH_M = 60.0     # incline runs: a slope this long (horizontal) above the water
 _INCLINE_START_X_M = -10.0   # and start on it this far landward of the waterline
-_TETHER_STIFFNESS_N_PER_M = 60.0  # drift: a person loosely holding the vehicle (assumed)
-_TETHER_DAMPING_N_PER_MPS = 60.0
 
 
 @dataclass
@@ -267,15 +266,13 @@ def drift(wave_height_m: float, duration_s: float = 60.0, wave_period_s: float |
     sim = SimCore.from_config(config, seed=seed,
                               overrides=_wave_overrides(wave_height_m, wave_period_s))
     sim.reset('afloat', yaw_rad=math.pi)
-    x0, y0 = sim.x, sim.y
+    x0 = sim.x
+    moor = sim.params.mooring
+    anchor = (sim.x + math.cos(sim.yaw) * moor.attach_x_m,
+              sim.y + math.sin(sim.yaw) * moor.attach_x_m)
 
     def hold(s: SimCore) -> None:
-        vx = math.cos(s.yaw) * s.u - math.sin(s.yaw) * s.v
-        vy = math.sin(s.yaw) * s.u + math.cos(s.yaw) * s.v
-        s.set_external_force(-_TETHER_STIFFNESS_N_PER_M * (s.x - x0)
-                             - _TETHER_DAMPING_N_PER_MPS * vx,
-                             -_TETHER_STIFFNESS_N_PER_M * (s.y - y0)
-                             - _TETHER_DAMPING_N_PER_MPS * vy)
+        s.set_external_force(*mooring(moor, s.x, s.y, s.yaw, s.u, s.v, s.r, anchor))
 
     run = ManeuverRun('drift')
     _drive(sim, run, duration_s, lambda t: Actuation(), hook=hold)

@@ -146,6 +146,41 @@ class SeakeepingParams:
 
 
 @dataclass(frozen=True)
+class SurfParams:
+    """Resistance of the wet, partly liquefied sand under the surf (issue 13)."""
+
+    wet_motion_resistance_coeff: float   # x W_e x the tracks' wetted share
+    max_resistance_n: float              # the tow tests' largest resistance (bound)
+
+    def __post_init__(self) -> None:
+        _positive(self, 'max_resistance_n')
+        if self.wet_motion_resistance_coeff < 0.0:
+            raise ConfigError('surf.wet_motion_resistance_coeff must be >= 0')
+
+
+@dataclass(frozen=True)
+class WaveMomentParams:
+    """Strip-wise wave moments (issue 13): yaw and roll from the transverse wave force."""
+
+    strip_moments: bool                  # false: only the total wave force (no moments)
+    transverse_force_z_m: float          # height of the strips' transverse force above the
+                                         # keel (the hulls' centre of buoyancy), m
+
+
+@dataclass(frozen=True)
+class MooringParams:
+    """The drift test's soft restraint: a line held at the bow (a spring and a damper)."""
+
+    stiffness_n_per_m: float
+    damping_n_per_mps: float
+    attach_x_m: float                    # where the line is made fast, base_link x, m
+
+    def __post_init__(self) -> None:
+        if self.stiffness_n_per_m < 0.0 or self.damping_n_per_mps < 0.0:
+            raise ConfigError('mooring stiffness and damping must be >= 0')
+
+
+@dataclass(frozen=True)
 class StartParams:
     """Where reset() puts the vehicle (x along the beach, m; yaw 0 faces the sea)."""
 
@@ -185,6 +220,9 @@ class SimParams:
     start: StartParams
     dry_soil: SoilParams | None
     propeller: PropellerParams
+    surf: SurfParams
+    wave_moments: WaveMomentParams
+    mooring: MooringParams
 
     @classmethod
     def from_params(cls, params: Mapping[str, ParamValue]) -> 'SimParams':
@@ -200,7 +238,10 @@ class SimParams:
                   build_settings(WaterParams, params, 'water'),
                   build_settings(SeakeepingParams, params, 'seakeeping'),
                   build_settings(StartParams, params, 'start'), dry,
-                  build_settings(PropellerParams, params, 'vehicle.propeller'))
+                  build_settings(PropellerParams, params, 'vehicle.propeller'),
+                  build_settings(SurfParams, params, 'surf'),
+                  build_settings(WaveMomentParams, params, 'waves.moments'),
+                  build_settings(MooringParams, params, 'mooring'))
         return out
 
 

@@ -299,3 +299,31 @@ def test_hull_heave_mass_and_damping_are_the_shared_models():
                                                                    rel=1e-9)
     assert heave.mass_kg > sim.vehicle.body.mass_kg     # added mass
 
+
+def _drift_yaw_rate_rms_dps(strip_moments: bool) -> float:
+    sim = SimCore.from_config(overrides={'waves.model': 'irregular',
+                                         'waves.moments.strip_moments': strip_moments}, seed=3)
+    sim.reset('afloat', yaw_rad=math.pi)
+    rates = [sim.step(Actuation()).yaw_rate_rps for _ in range(2500)]
+    return math.degrees(float(np.sqrt(np.mean(np.square(rates[500:])))))
+
+
+def test_a_short_crested_sea_yaws_a_drifting_vehicle_through_the_strip_moments():
+    # issue 13: the boat drifting in the surf yawed (RMS 6 deg/s); with only the total wave
+    # force a symmetric vehicle never yaws, whatever the sea
+    assert _drift_yaw_rate_rms_dps(strip_moments=False) < 1e-6
+    assert _drift_yaw_rate_rms_dps(strip_moments=True) > 0.3
+
+
+def _soil_force_n(coeff: float, x_m: float) -> float:
+    sim = SimCore.from_config(overrides={'surf.wet_motion_resistance_coeff': coeff})
+    sim.reset(x_m=x_m)
+    rows = [sim.step(Actuation(50, 50)) for _ in range(150)]
+    return float(np.mean([t.port_force_n + t.stbd_force_n for t in rows[100:]]))
+
+
+def test_the_wet_sand_resistance_loads_the_tracks_in_the_water_only():
+    # issue 13: the surf zone loads the tracks much more than the slope alone. At x = 1 m
+    # the tracks stand in ~8 cm of calm water (hulls dry); at -3 m on dry sand
+    assert _soil_force_n(0.1, 1.0) > _soil_force_n(0.0, 1.0) + 50.0
+    assert _soil_force_n(0.1, -3.0) == _soil_force_n(0.0, -3.0)

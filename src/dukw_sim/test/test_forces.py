@@ -1,11 +1,16 @@
 """dukw_sim.forces: the per-effect force terms and their one sum."""
 import math
 
+import dataclasses
+
+import numpy as np
 import pytest
 
 from dukw_sim.core import SimCore
-from dukw_sim.forces import (Wrench, hydrodynamic_drag, lateral_resistance, odom_force,
-                             propulsion, rolling_resistance, slope_gravity, sum_wrenches)
+from dukw_sim.forces import (Wrench, hydrodynamic_drag, lateral_resistance, mooring,
+                             odom_force, propulsion, rolling_resistance, slope_gravity,
+                             sum_wrenches, surf_resistance, track_wetness, wave_moments)
+from dukw_sim.world import WaterSample
 
 PARAMS = SimCore.from_config().params
 HALF_SEP_M = 0.6
@@ -90,3 +95,67 @@ def test_odom_force_rotates_into_body_axes():
     assert body.x_n == pytest.approx(10.0 * math.cos(yaw))
     assert body.y_n == pytest.approx(-10.0 * math.sin(yaw))
     assert body.n_nm == 3.0
+
+
+def _water(accel_x: np.ndarray, accel_y: np.ndarray) -> WaterSample:
+    zeros = np.zeros(accel_x.size)
+    return WaterSample(zeros, zeros, zeros, accel_x, accel_y)
+
+
+STATION_X_M = np.array([-1.0, 0.0, 1.0, -1.0, 0.0, 1.0])
+STATION_Y_M = np.array([0.4, 0.4, 0.4, -0.4, -0.4, -0.4])
+AREAS_M2 = np.full(6, 0.05)
+
+
+def test_a_uniform_transverse_wave_gives_no_yaw_and_a_gradient_does():
+    args = (0.3, PARAMS.waves, 1025.0, STATION_X_M, STATION_Y_M, (1.0, 0.0), -0.11)
+    uniform = wave_moments(False, AREAS_M2, 0.3, _water(np.zeros(6), np.full(6, 0.5)),
+                           *args[1:])
+    assert uniform.yaw_nm == pytest.approx(0.0, abs=1e-9)
+    # a force to port below the centre of gravity lifts the port side (REP 103 + roll)
+    assert uniform.roll_nm > 0.0
+    # the bow pushed to port, the stern to starboard: the bow swings to port (+ yaw)
+    twist = wave_moments(False, AREAS_M2, 0.3, _water(np.zeros(6), 0.5 * STATION_X_M),
+                         *args[1:])
+    mass_per_strip = PARAMS.waves.surge_inertia_coeff * 1025.0 * 0.05 * 0.3
+    assert twist.yaw_nm == pytest.approx(mass_per_strip * 0.5 * 4.0)
+    assert wave_moments(True, AREAS_M2, 0.3, _water(np.zeros(6), 0.5 * STATION_X_M),
+                        *args[1:]) == (0.0, 0.0, 0.0)
+
+
+def test_a_surge_wave_force_below_the_centre_of_gravity_lifts_the_bow():
+    forward = wave_moments(False, AREAS_M2, 0.3, _water(np.full(6, 0.5), np.zeros(6)),
+                           PARAMS.waves, 1025.0, STATION_X_M, STATION_Y_M, (1.0, 0.0), -0.11)
+    assert forward.pitch_nm < 0.0 and forward.yaw_nm == pytest.approx(0.0, abs=1e-9)
+
+
+def test_track_wetness_is_the_covered_share_of_the_tracks():
+    assert track_wetness(np.array([-0.2, 0.0]), 0.25) == 0.0
+    assert track_wetness(np.array([0.125, 0.5]), 0.25) == pytest.approx(0.75)
+    assert track_wetness(np.zeros(0), 0.25) == 0.0
+
+
+def test_surf_resistance_grows_with_wetness_and_weight_within_the_tow_test_bound():
+    surf = dataclasses.replace(PARAMS.surf, wet_motion_resistance_coeff=0.2)
+    assert surf_resistance(2000.0, 0.0, (0.5, 0.5), surf, HALF_SEP_M) == []
+    half = total(surf_resistance(2000.0, 0.5, (0.5, 0.5), surf, HALF_SEP_M), 'x_n')
+    full = total(surf_resistance(2000.0, 1.0, (0.5, 0.5), surf, HALF_SEP_M), 'x_n')
+    assert half == pytest.approx(-200.0, rel=1e-6) and full == pytest.approx(-400.0, rel=1e-6)
+    backwards = total(surf_resistance(2000.0, 1.0, (-0.5, -0.5), surf, HALF_SEP_M), 'x_n')
+    assert backwards == pytest.approx(400.0, rel=1e-6)
+    heavy = dataclasses.replace(surf, wet_motion_resistance_coeff=1.0)
+    capped = total(surf_resistance(2894.0, 1.0, (0.5, 0.5), heavy, HALF_SEP_M), 'x_n')
+    assert capped == pytest.approx(-surf.max_resistance_n, rel=1e-6)
+
+
+def test_mooring_pulls_back_to_the_anchor_and_turns_about_its_point():
+    moor = dataclasses.replace(PARAMS.mooring, stiffness_n_per_m=60.0, damping_n_per_mps=0.0,
+                               attach_x_m=-1.0)
+    anchor = (-1.0, 0.0)
+    assert mooring(moor, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, anchor) == pytest.approx((0.0, 0.0, 0.0))
+    fx, fy, moment = mooring(moor, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, anchor)
+    assert (fx, fy, moment) == pytest.approx((-30.0, 0.0, 0.0))
+    # turned to starboard (yaw -0.1), the stern swings to port: the line pulls it back to
+    # starboard, a + yaw moment that turns the vehicle back (held at the stern: stable)
+    _, fy, moment = mooring(moor, 0.0, 0.0, -0.1, 0.0, 0.0, 0.0, anchor)
+    assert fy < 0.0 and moment > 0.0

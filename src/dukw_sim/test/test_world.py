@@ -147,10 +147,13 @@ def test_vectorised_sample_matches_the_component_sum(spread):
     assert grid[1, 3] == pytest.approx(world.elevation_m(gx[1, 3], gy[1, 3], 4.0), abs=1e-12)
 
 
-def test_default_sea_is_the_one_of_before_the_spreading_option():
-    # waves.spreading_exponent_s = 0 (the default) keeps the sea of commit da3680a: these
+def test_uniform_spread_sea_is_the_one_of_before_the_spreading_option():
+    # waves.spreading_exponent_s = 0 with the uniform 0.35 rad spread (the default until
+    # issue 13 made the cos-2s sea the default) keeps the sea of commit da3680a: these
     # elevations were printed by that version's World for the same config and seed
-    world = SimCore.from_config(overrides={'waves.model': 'irregular'}, seed=1).world
+    world = SimCore.from_config(overrides={'waves.model': 'irregular', 'waves.spreading_rad': 0.35,
+                                           'waves.spreading_exponent_s': 0.0,
+                                           'waves.directions': 1}, seed=1).world
     eta = world.sample(np.array([5.0, 12.0, 20.0]), np.array([0.0, 0.6, -1.0]), 12.5)
     assert eta.elevation_m == pytest.approx(
         [-0.019371501576918866, 0.005617545545349607, 0.12081194374941635], abs=1e-14)
@@ -203,9 +206,9 @@ def test_short_crested_sea_keeps_hs_and_rocks_the_vehicle_sideways():
 
 
 @pytest.mark.parametrize('overrides', [
-    {'waves.spreading_exponent_s': 10.0, 'waves.directions': 6},          # with the uniform
-    {'waves.spreading_rad': 0.0, 'waves.spreading_exponent_s': 10.0},     # one direction
-    {'waves.directions': 4},                                              # bins, no s
+    {'waves.spreading_rad': 0.35, 'waves.spreading_exponent_s': 10.0},   # with the uniform
+    {'waves.spreading_exponent_s': 10.0, 'waves.directions': 1},          # one direction
+    {'waves.spreading_exponent_s': 0.0, 'waves.directions': 4},           # bins, no s
     {'waves.spreading_exponent_s': -1.0},
 ])
 def test_inconsistent_spreading_settings_are_rejected(overrides):
