@@ -38,6 +38,7 @@ class ContactModel:
         self.vehicle = vehicle
         self.settings = settings
         self.soil = soil
+        self.soil_cov = np.zeros((2, 2))   # covariance of (phi, k) of ``soil``, rad, m
         body = vehicle.body
         # the hull cylinders: waterline length centred on base_link (under the LCG), as the
         # simulator's hull strips; inside bow_x_m .. stern_x_m of the overall length

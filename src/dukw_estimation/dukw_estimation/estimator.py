@@ -56,7 +56,7 @@ class Estimator:
         """A new prior for the site's soil (e.g. a surveyed one): the online fit restarts
         from it."""
         self.online_soil.reset(soil)
-        self.contact.soil = self.online_soil.soil
+        self._use_online_soil()
 
     @property
     def ekf(self) -> MotionEkf:
@@ -74,7 +74,13 @@ class Estimator:
         self.contact.reset()
         self.surface.reset()
         self.online_soil.reset(self.online_soil.prior)
+        self._use_online_soil()
+
+    def _use_online_soil(self) -> None:
+        """The contact model takes the online soil and, when learning is on, its spread."""
         self.contact.soil = self.online_soil.soil
+        if self.settings.soil_online_enabled:
+            self.contact.soil_cov = self.online_soil.P.copy()
 
     def set_pose(self, x_m: float, y_m: float, yaw_rad: float) -> bool:
         """Reset the pose in odom; the waterline distance follows the new position."""
@@ -209,7 +215,7 @@ class Estimator:
             learnt |= online.update(s.t_s, slip, slip_sigma, weight, force,
                                     contact.track_area_m2, body.track_contact_length_m)
         if learnt:
-            contact.soil = online.soil
+            self._use_online_soil()
 
     def add_props(self, s: DriveStatus) -> Outcome:
         """Propeller thrusts, for the drive model afloat."""

@@ -152,6 +152,9 @@ class EkfSettings:
     force_update_gate: float = _f('force_update.mahalanobis', 'rejection distance: a force far '
                                   'off the model is more likely the model failing (a track '
                                   'half in the air, paddling) than the surface', 0.5, 1e6)
+    force_update_max_soil_spread: float = _f(
+        'force_update.max_soil_spread', "no force update while the soil's relative force "
+        'spread (soil_online) exceeds this: an unknown soil biases the surface', 0, 10)
     soil_preset: str = _f('soil_preset', "soil preset name; '' uses soil.*")
     # the site's soil learnt online on dry sand (soil_online.py)
     soil_online_enabled: bool = _f('soil_online.enabled', 'learn phi and k of the site from '
