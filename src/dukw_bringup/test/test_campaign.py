@@ -66,7 +66,8 @@ def twice(tmp_path_factory):
 
 def test_campaign_writes_one_row_per_run_summary_and_plots(twice):
     _, (out, _) = twice
-    for name in ('runs.csv', 'summary.json', 'histograms.png', 'metrics_vs_conditions.png'):
+    for name in ('runs.csv', 'runs.parquet', 'summary.json', 'histograms.png',
+                 'metrics_vs_conditions.png'):
         assert (out / name).stat().st_size > 0, name
     rows = _rows(out)
     assert [int(r['index']) for r in rows] == list(range(6))
@@ -82,6 +83,21 @@ def test_campaign_writes_one_row_per_run_summary_and_plots(twice):
     assert summary['share_meeting_targets'] == pytest.approx(met / 6, abs=1e-4)
     missed = {int(r['index']) for r in done if r['targets_met'] == 'False'}
     assert {r['index'] for r in summary['out_of_target_runs']} == missed
+
+
+def test_the_runs_table_is_also_parquet_typed_as_the_csv_says(twice):
+    import pyarrow.parquet as pq
+    _, (out, _) = twice
+    table = pq.read_table(out / 'runs.parquet').to_pylist()
+    rows = _rows(out)
+    assert [r['index'] for r in table] == [int(r['index']) for r in rows]
+    for typed, text in zip(table, rows, strict=True):
+        assert typed['kind'] == text['kind'] and typed['error'] == text['error']
+        if not text['error']:
+            assert typed['slip_rmse'] == float(text['slip_rmse'])
+            assert typed['targets_met'] is (text['targets_met'] == 'True')
+        else:
+            assert typed['slip_rmse'] is None and typed['targets_met'] is False
 
 
 def test_a_run_that_raises_is_recorded_with_its_traceback(twice):

@@ -205,7 +205,8 @@ class Estimator:
         learnt = False
         for k, side in enumerate((s.port, s.stbd)):
             slip = float(traction.slip(side.speed_mps, ground[k]))
-            if not online.informative(slip, side.speed_mps):
+            other = (s.stbd, s.port)[k].speed_mps
+            if not online.informative(slip, side.speed_mps, other):
                 continue
             lever = 0.5 * body.hull_separation_m * (-1.0 if k == 0 else 1.0)
             ground_var = max(P[Idx.U, Idx.U] + lever * lever * P[Idx.R, Idx.R]
@@ -302,4 +303,5 @@ def online_soil_settings(st: EkfSettings) -> OnlineSoilSettings:
         st.soil_online_enabled, st.soil_online_phi_min_rad, st.soil_online_phi_max_rad,
         st.soil_online_k_min_m, st.soil_online_k_max_m, st.soil_online_phi_sigma_rad,
         st.soil_online_k_sigma_m, st.soil_online_force_sigma_n, st.soil_online_min_slip,
-        st.soil_online_min_track_speed_mps, st.soil_online_period_s)
+        st.soil_online_min_track_speed_mps, st.soil_online_max_turn_mps,
+        st.soil_online_period_s)

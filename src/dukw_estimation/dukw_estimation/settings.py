@@ -172,6 +172,9 @@ class EkfSettings:
                                      'least this (past the grip)', 0, 1)
     soil_online_min_track_speed_mps: float = _f('soil_online.min_track_speed_mps', 'and the '
                                                 'track turns at least this fast', 0, 10)
+    soil_online_max_turn_mps: float = _f('soil_online.max_turn_mps', 'and the two tracks '
+                                         'differ by at most this (straight: no skid-steer '
+                                         'shear)', 0, 10)
     soil_online_dry_margin_m: float = _f('soil_online.dry_margin_m', 'dry sand: no hull '
                                          'volume even with the surface this much higher', 0, 5)
     soil_online_period_s: float = _f('soil_online.period_s', 'at most this often', 0, 60)

@@ -45,6 +45,7 @@ class OnlineSoilSettings:
     force_sigma_n: float
     min_slip: float
     min_track_speed_mps: float
+    max_turn_mps: float
     period_s: float
 
     def __post_init__(self) -> None:
@@ -91,11 +92,14 @@ class OnlineSoil:
         soil = replace(self.prior, friction_angle_rad=float(x[0]), shear_modulus_m=float(x[1]))
         return float(traction.tractive_force_n(slip, weight_n, soil, area_m2, length_m))
 
-    def informative(self, slip: float, track_mps: float) -> bool:
-        """Slipping enough (past the grip) on a track turning fast enough."""
+    def informative(self, slip: float, track_mps: float, other_track_mps: float) -> bool:
+        """Slipping enough (past the grip) on a track turning fast enough, driving straight
+        (in a skid-steer turn the tracks' sideways shear adds to their force: the Wong
+        model is the longitudinal force only)."""
         st = self.settings
         return (math.isfinite(slip) and abs(slip) >= st.min_slip
-                and abs(track_mps) >= st.min_track_speed_mps)
+                and abs(track_mps) >= st.min_track_speed_mps
+                and abs(track_mps - other_track_mps) <= st.max_turn_mps)
 
     def update(self, t_s: float, slip: float, slip_sigma: float, weight_n: float,
                force_n: float, area_m2: float, length_m: float) -> bool:

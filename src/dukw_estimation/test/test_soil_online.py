@@ -78,3 +78,13 @@ def test_the_estimate_stays_inside_the_papers_fitted_ranges():
     feed(online, SoilParams(0.0, 0.01, 0.5), np.tile(np.linspace(0.06, 0.6, 10), 10))
     assert online.soil.friction_angle_rad == pytest.approx(SETTINGS.phi_min_rad)
     assert SETTINGS.k_min_m <= online.soil.shear_modulus_m <= SETTINGS.k_max_m
+
+
+def test_only_a_slipping_track_driving_straight_fast_enough_is_informative():
+    online = OnlineSoil(PRIOR, SETTINGS)
+    assert online.informative(0.2, 0.8, 0.8)
+    assert online.informative(-0.1, 0.8, 0.75)
+    assert not online.informative(0.2, 0.8, 0.4)          # a skid-steer turn
+    assert not online.informative(0.2, 0.1, 0.1)          # nearly stopped
+    assert not online.informative(0.01, 0.8, 0.8)         # gripping
+    assert not online.informative(math.nan, 0.8, 0.8)
