@@ -304,4 +304,4 @@ def online_soil_settings(st: EkfSettings) -> OnlineSoilSettings:
         st.soil_online_k_min_m, st.soil_online_k_max_m, st.soil_online_phi_sigma_rad,
         st.soil_online_k_sigma_m, st.soil_online_force_sigma_n, st.soil_online_min_slip,
         st.soil_online_min_track_speed_mps, st.soil_online_max_turn_mps,
-        st.soil_online_period_s)
+        st.soil_online_max_slip_sigma, st.soil_online_period_s)

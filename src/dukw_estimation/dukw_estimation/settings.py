@@ -154,7 +154,8 @@ class EkfSettings:
                                   'half in the air, paddling) than the surface', 0.5, 1e6)
     force_update_max_soil_spread: float = _f(
         'force_update.max_soil_spread', "no force update while the soil's relative force "
-        'spread (soil_online) exceeds this: an unknown soil biases the surface', 0, 10)
+        'spread (soil_online) exceeds this: an unknown soil biases the surface (0: off, '
+        'the configured soil trusted)', 0, 10)
     soil_preset: str = _f('soil_preset', "soil preset name; '' uses soil.*")
     # the site's soil learnt online on dry sand (soil_online.py)
     soil_online_enabled: bool = _f('soil_online.enabled', 'learn phi and k of the site from '
@@ -175,6 +176,8 @@ class EkfSettings:
     soil_online_max_turn_mps: float = _f('soil_online.max_turn_mps', 'and the two tracks '
                                          'differ by at most this (straight: no skid-steer '
                                          'shear)', 0, 10)
+    soil_online_max_slip_sigma: float = _f('soil_online.max_slip_sigma', 'and the slip is '
+                                           'known to this (one sigma, from the filter)', 0, 1)
     soil_online_dry_margin_m: float = _f('soil_online.dry_margin_m', 'dry sand: no hull '
                                          'volume even with the surface this much higher', 0, 5)
     soil_online_period_s: float = _f('soil_online.period_s', 'at most this often', 0, 60)

@@ -46,6 +46,7 @@ class OnlineSoilSettings:
     min_slip: float
     min_track_speed_mps: float
     max_turn_mps: float
+    max_slip_sigma: float
     period_s: float
 
     def __post_init__(self) -> None:
@@ -105,12 +106,15 @@ class OnlineSoil:
                force_n: float, area_m2: float, length_m: float) -> bool:
         """One track's soil force ``force_n`` (N, signed like the slip) at ``slip`` with the
         track's share of the weight ``weight_n`` on dry sand. False (nothing changes) when
-        disabled, not due, non-finite or not informative (the caller checks the speed)."""
+        disabled, non-finite, not informative (the caller checks the speeds), the slip
+        too uncertain, or the force not signed like the slip."""
         st = self.settings
         values = (t_s, slip, slip_sigma, weight_n, force_n)
         if not st.enabled or not all(math.isfinite(v) for v in values) or weight_n <= 0.0 \
-                or abs(slip) < st.min_slip:
-            return False
+                or abs(slip) < st.min_slip or slip_sigma > st.max_slip_sigma \
+                or slip * force_n <= 0.0:
+            return False             # a force against the slip is not the Wong curve (a start
+                                     # from rest, static friction, a slip not yet converged)
         predicted = self._force(self.x, slip, weight_n, area_m2, length_m)
         h = np.array([
             (self._force(self.x + [PHI_STEP_RAD, 0.0], slip, weight_n, area_m2, length_m)

@@ -133,9 +133,11 @@ class SurfaceObserver:
         sin_t = math.sin(self.contact.slope_rad)
         half = 0.5 * self.vehicle.body.hull_separation_m
         lever = -half if k == 0 else half
-        soil_spread = self._soil_relative_variance(track_mps, ground_mps)
-        if soil_spread > st.force_update_max_soil_spread ** 2:
-            return                       # the site's soil is not known well enough yet
+        soil_spread = 0.0
+        if st.force_update_max_soil_spread > 0.0:
+            soil_spread = self._soil_relative_variance(track_mps, ground_mps)
+            if soil_spread > st.force_update_max_soil_spread ** 2:
+                return                   # the site's soil is not known well enough yet
         force = self.contact.soil_force_n
         predicted = force(x, x[Idx.S], x[Idx.ETA], track_mps, ground_mps)
         per_m = self._force_per_m(x, predicted, measured_n, track_mps, ground_mps)

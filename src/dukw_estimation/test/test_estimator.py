@@ -325,16 +325,18 @@ def test_slipping_track_forces_tell_the_weight_the_surface_leaves_on_the_tracks(
 
 
 def test_track_forces_wait_until_the_sites_soil_is_learnt():
-    """Meeting the sand in the surf (no dry sand yet), the soil is only the configured prior:
-    its error would read as water, so the surface is left to the other sensors."""
-    unknown = make(wave_sigma_m=0.07, waterline_sigma_m=0.05)
+    """With force_update.max_soil_spread set: meeting the sand in the surf (no dry sand
+    yet), the soil is only the configured prior, whose error would read as water, so the
+    surface is left to the other sensors."""
+    waits = {'force_update_max_soil_spread': 0.15}
+    unknown = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, **waits)
     _surf_run(unknown, -0.06, 0.4)
     assert unknown.online_soil.updates == 0
     deaf = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, force_update_sigma_n=0.0)
     _surf_run(deaf, -0.06, 0.4)
     assert unknown.traction().weight_on_tracks_fraction == pytest.approx(
         deaf.traction().weight_on_tracks_fraction, abs=1e-9)
-    learnt = make(wave_sigma_m=0.07, waterline_sigma_m=0.05)
+    learnt = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, **waits)
     learnt.contact.soil_cov *= 0.01              # as after dry sand: the force is used
     _surf_run(learnt, -0.06, 0.4)
     assert abs(learnt.traction().weight_on_tracks_fraction

@@ -65,6 +65,10 @@ def test_without_slip_the_prior_stays():
     assert online.soil == PRIOR
     assert not online.update(1.0, 0.2, 0.01, WEIGHT_N, math.nan, AREA_M2, LENGTH_M)
     assert not online.update(1.0, 0.2, 0.01, 0.0, 100.0, AREA_M2, LENGTH_M)   # no weight
+    # a start from rest: the force against a slip not yet converged, or the slip unsure
+    assert not online.update(1.0, -0.15, 0.01, WEIGHT_N, 200.0, AREA_M2, LENGTH_M)
+    assert not online.update(1.0, 0.2, 2 * SETTINGS.max_slip_sigma, WEIGHT_N, 60.0, AREA_M2,
+                             LENGTH_M)
     assert online.soil == PRIOR and online.updates == 0
 
 
