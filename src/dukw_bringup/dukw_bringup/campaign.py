@@ -305,7 +305,7 @@ def build_loop(spec: Spec, cond: Mapping[str, Any]):
     loop = ClosedLoop(sim_overrides(cond), seed=cond['sim_seed'], feedback='ekf',
                       estimator_knows_site=spec.oracle_site, sensor_filter=SensorFaults(cond))
     if spec.oracle_site:                 # diagnostic: the estimator knows the drawn soil too
-        loop.est.soil = loop.sim.vehicle.soil
+        loop.est.set_soil(loop.sim.vehicle.soil)
     loop.sensors.seed = cond['sensor_seed']
     loop.sensors.reset()
     start, yaw = {'land_to_sea': ('sand', 0.0), 'land_circle': ('flat', 0.0),

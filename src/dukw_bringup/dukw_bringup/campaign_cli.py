@@ -5,8 +5,9 @@
 
 By default a LocalCluster of W worker processes (one thread each) on this machine; with
 --scheduler, an existing cluster (`dask scheduler` + `dask worker ADDRESS` on machines with
-this workspace installed). Writes runs.csv, summary.json and plots into DIR (last line of
-the output). --rerun reproduces one run here, with its series.csv and series.png.
+this workspace installed). Writes runs.csv, runs.parquet, summary.json and plots into DIR
+(last line of the output). --rerun reproduces one run here, with its series.csv and
+series.png.
 Exit 0 when the campaign finished (whatever the share), 2 on a bad spec or option.
 """
 from __future__ import annotations
@@ -65,6 +66,7 @@ def write_campaign(spec: campaign.Spec, rows: list[dict], out: Path) -> dict:
     """runs.csv, summary.json and the plots into ``out``; the summary."""
     out.mkdir(parents=True, exist_ok=True)
     campaign_report.write_runs_csv(rows, out / 'runs.csv')
+    campaign_report.write_runs_parquet(rows, out / 'runs.parquet')
     summary = campaign_report.summarize(spec, rows)
     campaign_report.write_summary(summary, out / 'summary.json')
     campaign_report.plot_campaign(rows, out)

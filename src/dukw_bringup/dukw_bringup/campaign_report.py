@@ -1,6 +1,7 @@
-"""A campaign's output folder: runs.csv, summary.json, plots; one run's series (--rerun).
+"""A campaign's output folder: runs.csv / runs.parquet, summary.json, plots; one run's series.
 
-ROS-free. ``runs.csv`` has one row per run (drawn conditions, metrics, error traceback);
+ROS-free. ``runs.csv`` has one row per run (drawn conditions, metrics, error traceback),
+``runs.parquet`` the same table typed (pyarrow);
 ``summary.json`` the percentiles, the share meeting the estimator's targets and the
 indices of the runs that raised or missed a target; the plots histograms of the metrics
 and the metrics against wave height and soil.
@@ -36,6 +37,19 @@ def write_runs_csv(rows: Sequence[Mapping[str, Any]], path: Path) -> None:
         writer.writeheader()
         for row in sorted(rows, key=lambda r: r['index']):
             writer.writerow(row)
+
+
+def write_runs_parquet(rows: Sequence[Mapping[str, Any]], path: Path) -> None:
+    """The runs table as Parquet (pyarrow), sorted by index: each column typed from its
+    values (a run that raised has nulls where the others have metrics)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+    columns: list[str] = []
+    for row in rows:
+        columns += [k for k in row if k not in columns and not k.startswith('_')]
+    ordered = sorted(rows, key=lambda r: r['index'])
+    table = pa.table({c: pa.array([r.get(c) for r in ordered]) for c in columns})
+    pq.write_table(table, path)
 
 
 def _values(rows: Sequence[Mapping[str, Any]], key: str) -> np.ndarray:

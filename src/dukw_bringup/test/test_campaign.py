@@ -11,6 +11,7 @@ import pytest
 import yaml
 
 from dukw_bringup import campaign, campaign_cli
+from dukw_model import traction
 
 pytestmark = pytest.mark.timeout(300)
 
@@ -65,7 +66,8 @@ def twice(tmp_path_factory):
 
 def test_campaign_writes_one_row_per_run_summary_and_plots(twice):
     _, (out, _) = twice
-    for name in ('runs.csv', 'summary.json', 'histograms.png', 'metrics_vs_conditions.png'):
+    for name in ('runs.csv', 'runs.parquet', 'summary.json', 'histograms.png',
+                 'metrics_vs_conditions.png'):
         assert (out / name).stat().st_size > 0, name
     rows = _rows(out)
     assert [int(r['index']) for r in rows] == list(range(6))
@@ -81,6 +83,21 @@ def test_campaign_writes_one_row_per_run_summary_and_plots(twice):
     assert summary['share_meeting_targets'] == pytest.approx(met / 6, abs=1e-4)
     missed = {int(r['index']) for r in done if r['targets_met'] == 'False'}
     assert {r['index'] for r in summary['out_of_target_runs']} == missed
+
+
+def test_the_runs_table_is_also_parquet_typed_as_the_csv_says(twice):
+    import pyarrow.parquet as pq
+    _, (out, _) = twice
+    table = pq.read_table(out / 'runs.parquet').to_pylist()
+    rows = _rows(out)
+    assert [r['index'] for r in table] == [int(r['index']) for r in rows]
+    for typed, text in zip(table, rows, strict=True):
+        assert typed['kind'] == text['kind'] and typed['error'] == text['error']
+        if not text['error']:
+            assert typed['slip_rmse'] == float(text['slip_rmse'])
+            assert typed['targets_met'] is (text['targets_met'] == 'True')
+        else:
+            assert typed['slip_rmse'] is None and typed['targets_met'] is False
 
 
 def test_a_run_that_raises_is_recorded_with_its_traceback(twice):
@@ -200,3 +217,36 @@ def test_the_estimator_keeps_its_configured_beach_while_the_simulator_draws_anot
     configured = campaign.node_params('ekf_node')
     assert loop.est.vehicle.site.beach_slope_rad == configured['site.beach_slope_rad']
     assert loop.est.soil.friction_angle_rad == configured['soil.friction_angle_rad']
+
+
+def test_a_run_on_dry_sand_learns_the_drawn_soil_online():
+    """The estimator on a beach whose soil it was not given: on the dry part of a
+    land-to-sea run its force at the run's slip moves to the simulator's (soil_online)."""
+    spec = campaign.parse_spec(SPEC)
+    # transitions.yaml's run 55 (its tracks brake at a slip of -0.11 going downhill), calm
+    cond = dict(campaign.draw_conditions(spec, 0), kind='land_to_sea', beach_slope_deg=3.26,
+                significant_wave_height_m=0.0, soil_preset='', cohesion_kpa=0.111,
+                friction_angle_deg=5.81, shear_modulus_cm=11.15, speed_mps=0.92,
+                start_offset_m=0.35, gps_dropout=False, gps_outlier=False)
+    cond['sim.physics.dt_s'] = 0.01
+    loop = campaign.build_loop(spec, cond)
+    prior, body = loop.est.online_soil.prior, loop.est.vehicle.body
+    slips = []
+    for _ in range(int(5.0 / loop.sim.dt_s)):          # the dry part, before the waterline
+        loop.step((cond['speed_mps'], 0.0))
+        slips.append(loop.truth.port_slip)
+    assert loop.truth.weight_on_tracks_fraction > 0.999
+    online = loop.est.online_soil
+    assert online.updates >= 20
+    slip = sorted(slips[-300:])[150]
+    assert abs(slip) >= online.settings.min_slip
+
+    def force(soil):
+        weight = 0.5 * body.displacement_n * math.cos(math.radians(3.26))
+        area = body.track_width_m * body.track_contact_length_m
+        return traction.tractive_force_n(slip, weight, soil, area, body.track_contact_length_m)
+
+    site = loop.sim.vehicle.soil
+    assert abs(force(loop.est.soil) - force(site)) < 0.35 * abs(force(prior) - force(site))
+    assert loop.est.contact.soil == online.soil             # the contact model uses it
+

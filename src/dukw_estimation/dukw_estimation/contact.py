@@ -39,6 +39,7 @@ class ContactModel:
         self.vehicle = vehicle
         self.settings = settings
         self.soil = soil
+        self.soil_cov = np.zeros((2, 2))   # covariance of (phi, k) of ``soil``, rad, m
         body = vehicle.body
         # the hull cylinders: waterline length centred on base_link (under the LCG), as the
         # simulator's hull strips; inside bow_x_m .. stern_x_m of the overall length
@@ -157,6 +158,15 @@ class ContactModel:
         volume = buoyancy.grounded_volume_m3(*args, body.hull_radius_m, x[Idx.ETA], heading_cos,
                                              self.section)
         return h2, volume
+
+    def surface_volume_m3(self, x: np.ndarray, raise_m: float = 0.0) -> float:
+        """The volume under a surface ``raise_m`` above the estimated one, m^3 (0: dry)."""
+        body = self.vehicle.body
+        heading_cos = math.cos(x[Idx.YAW] - self.settings.seaward_yaw_rad)
+        return buoyancy.grounded_volume_m3(x[Idx.S], self.slope_rad, body.hull_clearance_m,
+                                           self.hull_bow_x_m, self.hull_stern_x_m,
+                                           body.hull_radius_m, x[Idx.ETA] + raise_m,
+                                           heading_cos, self.section)
 
     def weight_n(self, grounded_volume_m3: float, afloat: bool) -> float:
         """Weight on the tracks, N: none afloat; on the sand the hulls do not float."""

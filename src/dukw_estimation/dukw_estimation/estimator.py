@@ -27,6 +27,7 @@ from dukw_estimation.contact import ContactModel, ground_speeds
 from dukw_estimation.ekf import Idx, MotionEkf, Outcome
 from dukw_estimation.motion_filter import GROUNDED_FRACTION, MotionFilter
 from dukw_estimation.samples import OdometryEstimate, TractionEstimate
+from dukw_estimation.soil_online import OnlineSoil, OnlineSoilSettings
 from dukw_estimation.settings import SENSORS, EkfSettings
 from dukw_estimation.surface import SurfaceObserver
 
@@ -37,15 +38,26 @@ class Estimator:
     def __init__(self, vehicle: Vehicle, settings: EkfSettings, soil: SoilParams) -> None:
         self.vehicle = vehicle
         self.settings = settings
-        self.soil = soil
         self.motion_filter = MotionFilter(vehicle, settings)
         self.contact = ContactModel(vehicle, settings, soil)
+        self.online_soil = OnlineSoil(soil, online_soil_settings(settings))
         self.surface = SurfaceObserver(vehicle, settings, self.contact)
         self.counters: dict[str, dict[Outcome, int]] = {s: defaultdict(int) for s in SENSORS}
         self.rates = {s: RateCounter() for s in SENSORS}
         self.reset()
 
     # ------------------------------------------------------------------ state
+    @property
+    def soil(self) -> SoilParams:
+        """The soil the contact model uses now (the online estimate, or its prior)."""
+        return self.contact.soil
+
+    def set_soil(self, soil: SoilParams) -> None:
+        """A new prior for the site's soil (e.g. a surveyed one): the online fit restarts
+        from it."""
+        self.online_soil.reset(soil)
+        self._use_online_soil()
+
     @property
     def ekf(self) -> MotionEkf:
         """The EKF (state and covariance), the motion filter's."""
@@ -61,6 +73,14 @@ class Estimator:
         self.motion_filter.reset()
         self.contact.reset()
         self.surface.reset()
+        self.online_soil.reset(self.online_soil.prior)
+        self._use_online_soil()
+
+    def _use_online_soil(self) -> None:
+        """The contact model takes the online soil and, when learning is on, its spread."""
+        self.contact.soil = self.online_soil.soil
+        if self.settings.soil_online_enabled:
+            self.contact.soil_cov = self.online_soil.P.copy()
 
     def set_pose(self, x_m: float, y_m: float, yaw_rad: float) -> bool:
         """Reset the pose in odom; the waterline distance follows the new position."""
@@ -166,8 +186,37 @@ class Estimator:
         self.contact.smooth_track_forces(s)
         if not motion.fresh('gps_vel', s.t_s) and self.contact.fraction > GROUNDED_FRACTION:
             motion.track_odometry(s)
+        self._learn_soil(s)
         self.surface.track_forces(self.ekf, s)
         return self._settle('tracks', Outcome.ACCEPTED)
+
+    def _learn_soil(self, s: DriveStatus) -> None:
+        """On dry sand (no hull volume even with the surface ``soil_online.dry_margin_m``
+        higher) each slipping track's soil force at the known weight updates the site's
+        soil, which the contact model then uses."""
+        online, contact, st = self.online_soil, self.contact, self.settings
+        if not (st.soil_online_enabled and online.due(s.t_s)) or contact.afloat \
+                or contact.surface_volume_m3(self.ekf.x, st.soil_online_dry_margin_m) > 0.0:
+            return
+        body = self.vehicle.body
+        x, P = self.ekf.x, self.ekf.P
+        ground = ground_speeds(x, body.hull_separation_m)
+        weight = 0.5 * contact.weight_n(0.0, False)
+        learnt = False
+        for k, side in enumerate((s.port, s.stbd)):
+            slip = float(traction.slip(side.speed_mps, ground[k]))
+            other = (s.stbd, s.port)[k].speed_mps
+            if not online.informative(slip, side.speed_mps, other):
+                continue
+            lever = 0.5 * body.hull_separation_m * (-1.0 if k == 0 else 1.0)
+            ground_var = max(P[Idx.U, Idx.U] + lever * lever * P[Idx.R, Idx.R]
+                             + 2.0 * lever * P[Idx.U, Idx.R], 0.0)
+            slip_sigma = math.sqrt(ground_var) / abs(side.speed_mps)
+            force = contact.measured_soil_force_n(s, k) * math.copysign(1.0, side.speed_mps)
+            learnt |= online.update(s.t_s, slip, slip_sigma, weight, force,
+                                    contact.track_area_m2, body.track_contact_length_m)
+        if learnt:
+            self._use_online_soil()
 
     def add_props(self, s: DriveStatus) -> Outcome:
         """Propeller thrusts, for the drive model afloat."""
@@ -219,7 +268,7 @@ class Estimator:
         for k in range(2):
             slips[k] = traction.slip(speeds[k], ground[k])
             predicted[k] = traction.track_force_n(speeds[k], ground[k], 0.5 * weight_n,
-                                                  self.soil, self.contact.track_area_m2,
+                                                  self.contact.soil, self.contact.track_area_m2,
                                                   body.track_contact_length_m)
         return slips, predicted
 
@@ -246,3 +295,13 @@ class Estimator:
             filt.worsen(Level.WARN, 'waiting for a fix and a heading')
         out.append(filt)
         return out
+
+
+def online_soil_settings(st: EkfSettings) -> OnlineSoilSettings:
+    """The online soil fit's settings from the estimator's (``soil_online.*``)."""
+    return OnlineSoilSettings(
+        st.soil_online_enabled, st.soil_online_phi_min_rad, st.soil_online_phi_max_rad,
+        st.soil_online_k_min_m, st.soil_online_k_max_m, st.soil_online_phi_sigma_rad,
+        st.soil_online_k_sigma_m, st.soil_online_force_sigma_n, st.soil_online_min_slip,
+        st.soil_online_min_track_speed_mps, st.soil_online_max_turn_mps,
+        st.soil_online_max_slip_sigma, st.soil_online_period_s)

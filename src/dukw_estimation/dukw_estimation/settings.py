@@ -152,7 +152,35 @@ class EkfSettings:
     force_update_gate: float = _f('force_update.mahalanobis', 'rejection distance: a force far '
                                   'off the model is more likely the model failing (a track '
                                   'half in the air, paddling) than the surface', 0.5, 1e6)
+    force_update_max_soil_spread: float = _f(
+        'force_update.max_soil_spread', "no force update while the soil's relative force "
+        'spread (soil_online) exceeds this: an unknown soil biases the surface (0: off, '
+        'the configured soil trusted)', 0, 10)
     soil_preset: str = _f('soil_preset', "soil preset name; '' uses soil.*")
+    # the site's soil learnt online on dry sand (soil_online.py)
+    soil_online_enabled: bool = _f('soil_online.enabled', 'learn phi and k of the site from '
+                                   'the track forces on dry sand (prior: the configured soil)')
+    soil_online_phi_min_rad: float = _f('soil_online.phi_min_rad', 'lower bound of phi', 0, 1.4)
+    soil_online_phi_max_rad: float = _f('soil_online.phi_max_rad', 'upper bound of phi', 0, 1.4)
+    soil_online_k_min_m: float = _f('soil_online.k_min_m', 'lower bound of k', 0, 1)
+    soil_online_k_max_m: float = _f('soil_online.k_max_m', 'upper bound of k', 0, 1)
+    soil_online_phi_sigma_rad: float = _f('soil_online.phi_sigma_rad', 'prior sigma of phi',
+                                          1e-4, 1)
+    soil_online_k_sigma_m: float = _f('soil_online.k_sigma_m', 'prior sigma of k', 1e-4, 1)
+    soil_online_force_sigma_n: float = _f('soil_online.force_sigma_n', 'per track: force '
+                                          'noise of one update (current, friction)', 0.1, 1e4)
+    soil_online_min_slip: float = _f('soil_online.min_slip', 'learn only where |slip| is at '
+                                     'least this (past the grip)', 0, 1)
+    soil_online_min_track_speed_mps: float = _f('soil_online.min_track_speed_mps', 'and the '
+                                                'track turns at least this fast', 0, 10)
+    soil_online_max_turn_mps: float = _f('soil_online.max_turn_mps', 'and the two tracks '
+                                         'differ by at most this (straight: no skid-steer '
+                                         'shear)', 0, 10)
+    soil_online_max_slip_sigma: float = _f('soil_online.max_slip_sigma', 'and the slip is '
+                                           'known to this (one sigma, from the filter)', 0, 1)
+    soil_online_dry_margin_m: float = _f('soil_online.dry_margin_m', 'dry sand: no hull '
+                                         'volume even with the surface this much higher', 0, 5)
+    soil_online_period_s: float = _f('soil_online.period_s', 'at most this often', 0, 60)
 
     @classmethod
     def from_params(cls, params: Mapping[str, ParamValue]) -> 'EkfSettings':

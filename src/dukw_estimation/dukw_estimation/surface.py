@@ -8,6 +8,7 @@ touches only the surface states of the shared ``MotionEkf``.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -20,6 +21,7 @@ from dukw_estimation.settings import EkfSettings
 
 SECANT_STEPS_M = (0.005, 0.02, 0.05, 0.1, 0.2)   # surface steps of the force's derivative
 GROUND_STEP_MPS = 0.01                            # ground-speed step of the force's derivative
+SOIL_STEPS = (1e-3, 1e-3)                         # phi (rad), k (m) steps of the same
 
 
 class SurfaceObserver:
@@ -131,6 +133,11 @@ class SurfaceObserver:
         sin_t = math.sin(self.contact.slope_rad)
         half = 0.5 * self.vehicle.body.hull_separation_m
         lever = -half if k == 0 else half
+        soil_spread = 0.0
+        if st.force_update_max_soil_spread > 0.0:
+            soil_spread = self._soil_relative_variance(track_mps, ground_mps)
+            if soil_spread > st.force_update_max_soil_spread ** 2:
+                return                   # the site's soil is not known well enough yet
         force = self.contact.soil_force_n
         predicted = force(x, x[Idx.S], x[Idx.ETA], track_mps, ground_mps)
         per_m = self._force_per_m(x, predicted, measured_n, track_mps, ground_mps)
@@ -143,9 +150,35 @@ class SurfaceObserver:
         h = np.zeros(N_STATES)
         h[Idx.ETA] = per_m
         h[Idx.S] = per_m * sin_t         # the volume follows the water depth eta + s sin
-        var = st.force_update_sigma_n ** 2 + per_mps * per_mps * max(ground_var, 0.0)
+        var = st.force_update_sigma_n ** 2 + per_mps * per_mps * max(ground_var, 0.0) \
+            + soil_spread * max(measured_n * measured_n, predicted * predicted)
         ekf.update_scalar(measured_n, predicted, h, var, st.force_update_gate,
                           only=SURFACE_STATES)
+
+    def _soil_relative_variance(self, track_mps: float, ground_mps: float) -> float:
+        """The force model's relative variance from the soil's (phi, k) uncertainty: large
+        while the site's soil is only the configured prior (a sea-to-land run meets the sand
+        in the surf), small once the tracks have learnt it on dry sand (``soil_online``).
+        The soil scales the force at a slip about proportionally whatever the weight, so it
+        is taken at the full weight."""
+        cov = self.contact.soil_cov
+        if not np.any(cov):
+            return 0.0
+        contact, body = self.contact, self.vehicle.body
+        weight = 0.5 * contact.weight_n(0.0, False)
+
+        def force(soil) -> float:
+            return float(traction.track_force_n(track_mps, ground_mps, weight, soil,
+                                                contact.track_area_m2,
+                                                body.track_contact_length_m))
+        soil = contact.soil
+        full = force(soil)
+        if abs(full) < 1e-6:
+            return 0.0
+        jac = np.array([(force(replace(soil, **{name: getattr(soil, name) + step})) - full)
+                        / step for name, step in (('friction_angle_rad', SOIL_STEPS[0]),
+                                                  ('shear_modulus_m', SOIL_STEPS[1]))])
+        return float(jac @ cov @ jac) / (full * full)
 
     def _force_per_m(self, x: np.ndarray, predicted_n: float, measured_n: float,
                      track_mps: float, ground_mps: float) -> float | None:

@@ -122,7 +122,8 @@ def test_on_dry_land_all_weight_on_tracks_and_force_prediction_matches_the_model
     out = est.traction()
     assert out.submerged_volume_m3 == 0.0 and not out.afloat
     assert out.weight_on_tracks_fraction == pytest.approx(1.0)
-    soil = soil_params(PARAMS)
+    soil = est.soil                       # turning (1.1 / 1.3 m/s): nothing learnt
+    assert est.online_soil.updates == 0 and soil == soil_params(PARAMS)
     body = VEHICLE.body
     expected = traction.tractive_force_n(out.port_slip, out.effective_weight_n / 2, soil,
                                          body.track_width_m * body.track_contact_length_m,
@@ -313,13 +314,33 @@ def _surf_run(est, true_surface_m, slip_, seconds=5.0, x0=5.0, track_mps=0.5):
 def test_slipping_track_forces_tell_the_weight_the_surface_leaves_on_the_tracks():
     """In a trough 6 cm under the mean surface, the tracks carry more than the mean surface
     says; slipping, their forces show it and pull the estimate most of the way there."""
-    told = make(wave_sigma_m=0.07, waterline_sigma_m=0.05)
+    known = {'soil_online_enabled': False}          # the configured soil is the site's
+    told = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, **known)
     truth = _surf_run(told, -0.06, 0.4)
-    deaf = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, force_update_sigma_n=0.0)
+    deaf = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, force_update_sigma_n=0.0, **known)
     _surf_run(deaf, -0.06, 0.4)
     off = abs(deaf.traction().weight_on_tracks_fraction - truth)
     assert off > 0.1                                   # the mean surface alone is well off
     assert abs(told.traction().weight_on_tracks_fraction - truth) < 0.4 * off
+
+
+def test_track_forces_wait_until_the_sites_soil_is_learnt():
+    """With force_update.max_soil_spread set: meeting the sand in the surf (no dry sand
+    yet), the soil is only the configured prior, whose error would read as water, so the
+    surface is left to the other sensors."""
+    waits = {'force_update_max_soil_spread': 0.15}
+    unknown = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, **waits)
+    _surf_run(unknown, -0.06, 0.4)
+    assert unknown.online_soil.updates == 0
+    deaf = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, force_update_sigma_n=0.0)
+    _surf_run(deaf, -0.06, 0.4)
+    assert unknown.traction().weight_on_tracks_fraction == pytest.approx(
+        deaf.traction().weight_on_tracks_fraction, abs=1e-9)
+    learnt = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, **waits)
+    learnt.contact.soil_cov *= 0.01              # as after dry sand: the force is used
+    _surf_run(learnt, -0.06, 0.4)
+    assert abs(learnt.traction().weight_on_tracks_fraction
+               - deaf.traction().weight_on_tracks_fraction) > 0.05
 
 
 def test_track_forces_are_not_used_at_low_slip():
@@ -345,7 +366,7 @@ def test_tracks_pushing_under_a_hull_thought_afloat_bring_the_weight_back():
     """The estimate starts with the surface 20 cm too high (the volume capped at the
     displacement: no weight on the tracks, the force's local derivative nil); the slipping
     tracks push with the true weight on them, and the estimate follows."""
-    est = make(wave_sigma_m=0.07, waterline_sigma_m=0.05)
+    est = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, soil_online_enabled=False)
     est.ekf.x[Idx.ETA] = 0.2
     truth = _surf_run(est, 0.0, 0.4, seconds=0.3, x0=4.0)
     assert 0.2 < truth < 0.9
