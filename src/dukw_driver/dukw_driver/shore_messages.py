@@ -7,7 +7,7 @@ import math
 from dukw_common.geometry import euler_from_quaternion
 from dukw_common.node_tools import ParamSpec
 from dukw_driver.shore_link import STREAMS, MissionPlan
-from dukw_driver.shore_telemetry import Drive, Fix, Pose, TractionState
+from dukw_driver.shore_telemetry import DriveTelemetry, Fix, Pose, TractionState
 
 
 PARAMS = [
@@ -58,12 +58,12 @@ def fix_from_navsat(msg) -> Fix:
                vertical)
 
 
-def drive_from_status(msg) -> Drive:
-    """dukw_msgs/DrivetrainStatus -> Drive."""
+def drive_from_status(msg) -> DriveTelemetry:
+    """dukw_msgs/DrivetrainStatus -> DriveTelemetry (what the shore link reports of a drive)."""
     sides = (msg.port, msg.stbd)
     faults = tuple(f'{side} {name}' for side, s in zip(('port', 'stbd'), sides, strict=True)
                    for name in s.faults)
-    return Drive(msg.connected, tuple(s.current_a for s in sides),
+    return DriveTelemetry(msg.connected, tuple(s.current_a for s in sides),
                  tuple(s.voltage_v for s in sides), tuple(s.command_pct for s in sides), faults)
 
 
