@@ -73,6 +73,23 @@ def test_minimum_land_turning_radius(port, stbd, radius_m, turn):
     assert run.summary['radius_m'] == pytest.approx(radius_m, rel=0.15)
 
 
+@pytest.mark.parametrize('mirror', [False, True])
+def test_land_turn_radius_grows_as_the_differential_shrinks_both_ways(mirror):
+    """Skid steering (issue 13): at one mean command the radius grows steadily as the
+    differential shrinks, left and right (the right turns with the 4 % port bias added so
+    both sides run the same speeds), far beyond the kinematic 0.405 m x mean / half-diff."""
+    radii = []
+    for diff in (48, 32, 16):
+        slow, fast = 60 - diff / 2, 60 + diff / 2
+        port, stbd = (fast + 4, slow) if mirror else (slow + 4, fast)
+        run = maneuver.circle('land', port, stbd, duration_s=20.0)
+        assert run.summary['turn'] == ('starboard' if mirror else 'port')
+        radii.append(run.summary['radius_m'])
+    assert radii[0] < radii[1] < radii[2]
+    assert radii[2] > 2.0 * radii[0]
+    assert radii[1] > 1.5 * 0.405 * 60 / 16            # 1.5 x the kinematic radius
+
+
 @pytest.mark.parametrize('port, stbd', [(100, -100), (-100, 100)])
 def test_afloat_turning_radius_with_one_propeller_reversed(port, stbd):
     run = maneuver.circle('water', port, stbd, duration_s=40.0)
