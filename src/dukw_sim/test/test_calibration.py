@@ -25,8 +25,11 @@ def zero_crossing_hz(signal: np.ndarray, dt: float) -> float:
 
 
 def test_top_speed_on_flat_sand_100_96():
+    """Section 3: about 2 m/s on flat dry sand. 100 % is 2 m/s of track speed; the port
+    track's 4 % deficit and the speed loops' droop under rolling resistance and belt
+    friction (~0.04 m/s) take it a little below."""
     run = maneuver.circle('land', 100, 96, duration_s=12.0)
-    assert run.summary['speed_mps'] == pytest.approx(2.0, rel=0.05)
+    assert 1.85 <= run.summary['speed_mps'] <= 2.0
 
 
 def test_top_speed_afloat_full_thrust():
@@ -70,6 +73,23 @@ def test_minimum_land_turning_radius(port, stbd, radius_m, turn):
     assert run.summary['radius_m'] == pytest.approx(radius_m, rel=0.15)
 
 
+@pytest.mark.parametrize('mirror', [False, True])
+def test_land_turn_radius_grows_as_the_differential_shrinks_both_ways(mirror):
+    """Skid steering (issue 13): at one mean command the radius grows steadily as the
+    differential shrinks, left and right (the right turns with the 4 % port bias added so
+    both sides run the same speeds), far beyond the kinematic 0.405 m x mean / half-diff."""
+    radii = []
+    for diff in (48, 32, 16):
+        slow, fast = 60 - diff / 2, 60 + diff / 2
+        port, stbd = (fast + 4, slow) if mirror else (slow + 4, fast)
+        run = maneuver.circle('land', port, stbd, duration_s=20.0)
+        assert run.summary['turn'] == ('starboard' if mirror else 'port')
+        radii.append(run.summary['radius_m'])
+    assert radii[0] < radii[1] < radii[2]
+    assert radii[2] > 2.0 * radii[0]
+    assert radii[1] > 1.5 * 0.405 * 60 / 16            # 1.5 x the kinematic radius
+
+
 @pytest.mark.parametrize('port, stbd', [(100, -100), (-100, 100)])
 def test_afloat_turning_radius_with_one_propeller_reversed(port, stbd):
     run = maneuver.circle('water', port, stbd, duration_s=40.0)
@@ -93,20 +113,26 @@ def test_radius_grows_with_slip_on_soft_sand():
     assert soft > 1.2 * firm.summary['radius_m']
 
 
-def test_eleven_degrees_at_full_command_climbs_at_35_to_43_a():
-    run = maneuver.incline(11.0, 100, stbd=96, duration_s=12.0)
+def test_eleven_degrees_at_equal_full_commands_climbs_at_the_papers_currents():
+    """The paper climbed 11 deg at equal 100 % commands on both tracks: port 35.36 A,
+    starboard 42.53 A (+-15 %). The port track's speed deficit leaves it less of the load."""
+    run = maneuver.incline(11.0, 100, duration_s=12.0)
     s = run.summary
+    assert s['stbd_pct'] == 100
     assert not s['stalled'] and s['climbed_m'] > 10.0
-    assert 35.0 <= s['mean_port_current_a'] <= 43.0
-    assert 35.0 <= s['mean_stbd_current_a'] <= 43.0
+    assert s['mean_port_current_a'] == pytest.approx(35.36, rel=0.15)
+    assert s['mean_stbd_current_a'] == pytest.approx(42.53, rel=0.15)
+    assert s['mean_port_current_a'] < s['mean_stbd_current_a']
 
 
-def test_nineteen_degrees_stalls_far_over_the_continuous_limit():
-    run = maneuver.incline(19.0, 100, stbd=96, duration_s=14.0)
+def test_nineteen_degrees_at_equal_full_commands_stalls_far_over_the_continuous_limit():
+    """19 deg at equal 100 %: stalls without track slip at port 54.83 / starboard 61.46 A."""
+    run = maneuver.incline(19.0, 100, duration_s=14.0)
     s = run.summary
     assert s['stalled'] and s['climbed_m'] < 1.0
-    limit = 35.0
-    assert min(s['mean_port_current_a'], s['mean_stbd_current_a']) > 1.66 * limit
+    assert s['mean_port_current_a'] == pytest.approx(54.83, rel=0.15)
+    assert s['mean_stbd_current_a'] == pytest.approx(61.46, rel=0.15)
+    assert max(s['mean_port_current_a'], s['mean_stbd_current_a']) > 1.66 * 35.0
 
 
 def pulls_forward(pull_n: float) -> bool:
@@ -169,9 +195,11 @@ def test_froude_krylov_surge_force_on_a_28_cm_4_88_s_wave():
 
 
 def test_land_to_sea_on_tracks_only_floats_off():
+    # the paper's runs lasted 30 s; at 64 % the drooping drives on the short-crested sea
+    # float the vehicle off only after ~20 s (the last touch of a trough at 20.2 s, seed 1)
     for command in (64, 100):
         run = maneuver.transition('land-to-sea', command, wave_height_m=0.28, seed=1,
-                                  duration_s=20.0)
+                                  duration_s=30.0)
         rows = run.rows
         assert rows[0].medium == Medium.LAND
         assert rows[0].effective_weight_n > 2800.0

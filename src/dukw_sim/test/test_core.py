@@ -226,7 +226,8 @@ def test_track_forces_are_smooth_from_rest():
     sim.reset(x_m=-30.0)
     forces = np.array([sim.step(Actuation(64, 60)).stbd_force_n for _ in range(300)])
     assert forces.min() > 0.0
-    assert np.max(np.abs(np.diff(forces[1:30]))) < 5.0
+    rise = np.diff(forces[1:30])      # the drives' speed-torque line builds it up in ~0.4 s
+    assert (rise > 0.0).all() and np.max(np.abs(np.diff(rise))) < 3.0
 
 
 @pytest.mark.parametrize('start', ['sand', 'surf', 'afloat'])

@@ -75,18 +75,22 @@ def test_bad_reference_is_a_clear_error(tmp_path):
     assert proc.returncode == 2 and 'cannot read reference file' in proc.stderr
 
 
-#: The optional skid-steer set of config/dukw.yaml (sim_node land.*, issue 13).
-SKID_STEER = ['drivetrain.port_extra_friction_n=0', 'land.speed_loop_droop_mps_per_kn=1.43',
-              'land.lateral_friction_coeff=0.11', 'land.lateral_slip_speed_mps=0.05',
-              'land.lateral_damping_n_per_mps=1600']
-
-
-def test_skid_steer_set_meets_the_land_turns_and_equal_command_inclines(capsys):
-    """Radius grows as the differential shrinks (8 radii within 20 %), the port bias holds
-    and the equal-command incline currents come out (port below starboard, +-15 %)."""
-    args = ['--only', 'land_turns', 'port_bias', 'inclines', '--no-zigzags']
-    assert validate.main(args + [a for s in SKID_STEER for a in ('--set', s)]) == 0
+def test_land_turns_port_bias_and_equal_command_inclines_meet_the_paper(capsys):
+    """The default skid-steer physics (issue 13): radius grows as the differential shrinks
+    (8 radii within 20 %), the port bias holds and the equal-command incline currents come
+    out (port below starboard, +-15 %)."""
+    assert validate.main(['--only', 'land_turns', 'port_bias', 'inclines', '--no-zigzags']) == 0
     assert capsys.readouterr().out.splitlines()[-1] == 'score: 16/16 checks ok'
+
+
+def test_the_old_stiff_drives_saturate_the_land_turns(capsys):
+    """Without the drives' droop and the rate-dependent lateral resistance (the model before
+    issue 13) the moderate turns come out 2-3 x too tight: the check can fail."""
+    old = ['land.speed_loop_droop_mps_per_kn=0', 'land.lateral_friction_coeff=0.74',
+           'land.lateral_slip_speed_mps=0.2', 'land.lateral_damping_n_per_mps=0']
+    args = ['--only', 'land_turns', '--no-zigzags'] + [a for s in old for a in ('--set', s)]
+    assert validate.main(args) == 1
+    assert 'OFF' in capsys.readouterr().out
 
 
 def test_set_rejects_an_unknown_parameter(tmp_path):
