@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from dukw_model.scalars import is_scalar
+
 ArrayLike = float | np.ndarray
 
 
@@ -64,7 +66,7 @@ def submerged_volume_on_slope(h2_m: ArrayLike, slope_rad: float, radius_m: float
 def segment_area_m2(depth_m: ArrayLike, radius_m: float) -> ArrayLike:
     """Immersed cross-section of a horizontal circle of radius r, water depth d over its bottom."""
     r = radius_m
-    if np.ndim(depth_m) == 0:                   # the scalar path, without numpy's overhead
+    if is_scalar(depth_m):                        # the scalar path, without numpy's overhead
         h = r - min(max(float(depth_m), 0.0), 2.0 * r)
         return (r * r * float(np.arccos(min(max(h / r, -1.0), 1.0)))   # numpy: same bits
                 - h * math.sqrt(max(r * r - h * h, 0.0)))
@@ -138,7 +140,7 @@ class HullSection:
 
     def area_m2(self, depth_m: ArrayLike) -> ArrayLike:
         """Immersed section from the water height over the hull bottom, m^2 (vectorised)."""
-        if np.ndim(depth_m) == 0:                   # the scalar path, without numpy's overhead
+        if is_scalar(depth_m):                        # the scalar path, without numpy's overhead
             d = min(float(depth_m), self.top_depth_m)
             return (segment_area_m2(min(d, self.float_depth_m), self.radius_m)
                     + self.strut_width_m * max(d - self.float_depth_m, 0.0))

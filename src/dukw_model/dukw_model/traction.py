@@ -13,6 +13,8 @@ import math
 
 import numpy as np
 
+from dukw_model.scalars import is_scalar
+
 from dukw_common.vehicle import SoilParams
 
 ArrayLike = float | np.ndarray
@@ -26,7 +28,7 @@ def slip(track_speed_mps: ArrayLike, ground_speed_mps: ArrayLike,
     the track's sign), so a stopped track with a moving vehicle gives a large
     negative slip instead of infinity; the result is clipped to [-1, 1].
     """
-    if np.ndim(track_speed_mps) == 0 and np.ndim(ground_speed_mps) == 0:   # scalar path
+    if is_scalar(track_speed_mps) and is_scalar(ground_speed_mps):   # scalar path
         v_t, v_r = float(track_speed_mps), float(ground_speed_mps)
         denom = max(abs(v_t), min_track_speed_mps) * (1.0 if v_t >= 0.0 else -1.0)
         return min(max((v_t - v_r) / denom, -1.0), 1.0)
@@ -44,7 +46,7 @@ def shear_development(slip_abs: ArrayLike, contact_length_m: float,
 
     Safe at |i| -> 0 (series 1 - (1 - x/2) = x/2) and at k -> 0 (-> 1).
     """
-    if np.ndim(slip_abs) == 0:                                          # scalar path
+    if is_scalar(slip_abs):                                          # scalar path
         s = abs(float(slip_abs))
         if shear_modulus_m <= 1e-9:
             return 1.0 if s > 0.0 else 0.0
@@ -78,7 +80,7 @@ def tractive_force_n(slip_: ArrayLike, effective_weight_n: ArrayLike, soil: Soil
     for one track. No weight on the tracks (afloat) gives no cohesion either:
     the patch is off the ground.
     """
-    if np.ndim(slip_) == 0 and np.ndim(effective_weight_n) == 0:        # scalar path
+    if is_scalar(slip_) and is_scalar(effective_weight_n):        # scalar path
         i, w = float(slip_), max(float(effective_weight_n), 0.0)
         sign = math.copysign(1.0, i) if i != 0.0 else 0.0      # as np.sign: +0 at either zero
         tan_phi = float(np.tan(soil.friction_angle_rad))       # numpy: the same bits
