@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from dukw_bringup.accuracy import ACCURACY_COLUMNS, accuracy
 from dukw_common.config import node_params
 
 KINDS = ('land_to_sea', 'sea_to_land', 'land_circle', 'water_circle')
@@ -43,7 +44,6 @@ BOUNDS = {'significant_wave_height_m': (0.0, 1.0), 'peak_period_s': (1.0, 20.0),
 FAULTS = {'gps_dropout': ('start_s', 'duration_s'), 'gps_outlier': ('start_s', 'offset_m')}
 TARGET_NAMES = ('slip_rmse', 'volume_error_pct', 'fraction_error', 'mode_delay_s')
 EARTH_RADIUS_M = 6_371_000.0
-MOVING_TRACK_MPS = 0.1          # slip is scored only where the track turns (as evaluate)
 
 
 class SpecError(ValueError):
@@ -338,34 +338,16 @@ def simulate(spec: Spec, cond: Mapping[str, Any]) -> tuple[np.ndarray, list, Any
     return np.array(rows, dtype=float), loop.record.modes, loop
 
 
-def _rms(values: np.ndarray) -> float:
-    values = values[np.isfinite(values)]
-    return float(np.sqrt(np.mean(np.square(values)))) if values.size else 0.0
-
-
 def score(spec: Spec, cond: Mapping[str, Any], s: np.ndarray, mode_log: list, loop) -> dict:
     """The run's metrics from its series (estimate vs truth, modes vs medium, currents)."""
     col = {name: s[:, k] for k, name in enumerate(SERIES_COLUMNS)}
-    body = loop.sim.vehicle.body
     scored = col['t_s'] >= spec.warm_up_s
-    speeds = np.column_stack([col['port_track_mps'], col['stbd_track_mps']])
-    slip_err = np.concatenate([
-        (col['est_port_slip'] - col['port_slip'])[scored & (np.abs(speeds[:, 0]) >
-                                                           MOVING_TRACK_MPS)],
-        (col['est_stbd_slip'] - col['stbd_slip'])[scored & (np.abs(speeds[:, 1]) >
-                                                           MOVING_TRACK_MPS)]])
-    yaw_err = np.remainder(col['est_yaw_rad'] - col['yaw_rad'] + math.pi, 2 * math.pi) - math.pi
     current = np.maximum(np.abs(col['port_current_a']), np.abs(col['stbd_current_a']))
     limit_a = loop.sim.vehicle.drivetrain.continuous_current_limit_a
     to_water, to_land = _mode_delays(col['t_s'], col['medium'], mode_log)
     out = {
-        'position_rmse_m': _rms(np.hypot(col['est_x_m'] - col['x_m'],
-                                         col['est_y_m'] - col['y_m'])[scored]),
-        'heading_rmse_deg': math.degrees(_rms(yaw_err[scored])),
-        'slip_rmse': _rms(slip_err),
-        'volume_error_pct': 100.0 * _rms((col['est_volume_m3'] - col['volume_m3'])[scored])
-        / body.displaced_volume_m3,
-        'fraction_error': _rms((col['est_fraction'] - col['fraction'])[scored]),
+        **accuracy({name: col[name][scored] for name in ACCURACY_COLUMNS},
+                   loop.sim.vehicle.body.displaced_volume_m3),
         'mode_delay_to_water_s': to_water,
         'mode_delay_to_land_s': to_land,
         'chatter_count': _chatter(col['medium'], mode_log),

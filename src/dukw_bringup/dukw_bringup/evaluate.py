@@ -26,15 +26,14 @@ from typing import Sequence
 
 import numpy as np
 
+from dukw_bringup.accuracy import ACCURACY_COLUMNS, accuracy
 from dukw_bringup.stack_harness import SENSOR_TOPICS, ClosedLoop
 from dukw_common.config import ConfigError
-from dukw_common.vehicle import Vehicle
 from dukw_sim.core import Actuation
 
 TARGETS = {'position_rmse_m': 0.5, 'heading_rmse_deg': 3.0, 'slip_rmse': 0.05,
            'volume_error_pct': 10.0, 'fraction_error': 0.1}
 WARM_UP_S = 2.0                # scored from here: the filter has had a fix and a heading
-MOVING_TRACK_MPS = 0.1         # slip is scored only where the track turns
 
 
 @dataclass(frozen=True)
@@ -93,34 +92,25 @@ def run_scenario(scenario: Scenario, duration_s: float = 30.0, seed: int = 0,
         if truth.t_s < WARM_UP_S or est.t_s is None:
             continue
         odo, trc = est.odometry(), est.traction()
-        rows.append((odo.x_m - truth.x_m, odo.y_m - truth.y_m,
-                     math.remainder(odo.yaw_rad - truth.yaw_rad, 2 * math.pi),
-                     trc.port_slip - truth.port_slip, trc.stbd_slip - truth.stbd_slip,
-                     abs(truth.port_track_speed_mps) > MOVING_TRACK_MPS,
-                     abs(truth.stbd_track_speed_mps) > MOVING_TRACK_MPS,
-                     trc.submerged_volume_m3 - truth.submerged_volume_m3,
-                     trc.weight_on_tracks_fraction - truth.weight_on_tracks_fraction))
-    result = score(scenario, np.array(rows, dtype=float), stack.sim.vehicle, truth, est)
+        rows.append((truth.x_m, truth.y_m, truth.yaw_rad, odo.x_m, odo.y_m, odo.yaw_rad,
+                     truth.port_slip, truth.stbd_slip, trc.port_slip, trc.stbd_slip,
+                     truth.port_track_speed_mps, truth.stbd_track_speed_mps,
+                     truth.submerged_volume_m3, trc.submerged_volume_m3,
+                     truth.weight_on_tracks_fraction, trc.weight_on_tracks_fraction))
+    series = np.array(rows, dtype=float).reshape(-1, len(ACCURACY_COLUMNS))
+    result = score(scenario, series, stack.sim, truth, est)
     if oracle_surface:
         result['oracle'] = 'surface'
     return result
 
 
-def _rms(values: np.ndarray) -> float:
-    return float(np.sqrt(np.mean(np.square(values)))) if values.size else 0.0
-
-
-def score(scenario: Scenario, rows: np.ndarray, vehicle: Vehicle, last_truth, est) -> dict:
-    """Metrics of one run from the per-step errors."""
-    slip_err = np.concatenate([rows[rows[:, 5] > 0, 3], rows[rows[:, 6] > 0, 4]])
+def score(scenario: Scenario, series: np.ndarray, sim, last_truth, est) -> dict:
+    """Metrics of one run from its scored samples (columns ACCURACY_COLUMNS)."""
+    col = {name: series[:, k] for k, name in enumerate(ACCURACY_COLUMNS)}
     out = {
         'scenario': scenario.name,
-        'position_rmse_m': _rms(np.hypot(rows[:, 0], rows[:, 1])),
-        'heading_rmse_deg': math.degrees(_rms(rows[:, 2])),
-        'slip_rmse': _rms(slip_err),
-        'volume_error_pct': 100.0 * _rms(rows[:, 7]) / vehicle.body.displaced_volume_m3,
-        'fraction_error': _rms(rows[:, 8]),
-        'scored_s': round(rows.shape[0] * 0.01, 2),
+        **accuracy(col, sim.vehicle.body.displaced_volume_m3),
+        'scored_s': round(series.shape[0] * sim.dt_s, 2),
         'end_medium': last_truth.medium.name,
         'rejected': {s: sum(n for o, n in c.items() if o.value.startswith('rejected'))
                      for s, c in est.counters.items()},
