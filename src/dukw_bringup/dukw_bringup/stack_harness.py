@@ -81,17 +81,11 @@ class TruthOracle:
     """Stands in for the EKF runner: the simulator's truth as the estimate, on each IMU
     sample (``feedback='truth'``)."""
 
-    rate_hz = 100.0
-
     def __init__(self) -> None:
         self.truth = Truth()
-        self.t_s: float | None = None
 
     def on_sample(self, topic: str, sample: Any, now_s: float) -> Estimate | None:
-        if topic != 'imu/data':
-            return None
-        self.t_s = now_s
-        return self.estimate()
+        return self.estimate() if topic == 'imu/data' else None
 
     def tick(self, now_s: float) -> Estimate | None:
         return None
@@ -111,9 +105,6 @@ class TruthOracle:
 def default_controller_settings() -> ControllerSettings:
     return controller_settings(node_params('drive_controller_node'))
 
-
-def default_mode_settings() -> ModeSettings:
-    return modes.settings_from_params(node_params('mode_manager_node'))
 
 
 class Stack:
@@ -323,15 +314,10 @@ class ClosedLoop(Stack):
         ekf = (TruthOracle() if feedback == 'truth' else EkfRunner.from_params(
             ekf_params, vehicle=sim.vehicle if estimator_knows_site else Vehicle.from_params(
                 ekf_params)))
-        mode_params = node_params('mode_manager_node', config)
-        controller_params = node_params('drive_controller_node', config)
-        mode_manager = ModeManagerRunner(
-            ModeManager(mode_settings or modes.settings_from_params(mode_params)),
-            float(mode_params['rate_hz']), float(mode_params['republish_period_s']))
-        controller = DriveControllerRunner(
-            DriveController(controller_settings or default_controller_settings()),
-            float(controller_params['rate_hz']),
-            bool(controller_params['step_on_odometry']))
+        mode_manager = ModeManagerRunner.from_params(node_params('mode_manager_node', config),
+                                                     mode_settings)
+        controller = DriveControllerRunner.from_params(
+            node_params('drive_controller_node', config), controller_settings)
         super().__init__(sim, SensorModel.from_config(config, seed=seed), ekf, mode_manager,
                          controller, switch, wire, sensor_filter, actuation)
         self.feedback = feedback

@@ -21,9 +21,9 @@ from dataclasses import dataclass
 from typing import Mapping
 
 from dukw_common.config import ParamValue
-from dukw_control.controller import ControlOutput, DriveController
+from dukw_control.controller import ControlOutput, ControllerSettings, DriveController
 from dukw_control.controller import settings_from_params as controller_settings
-from dukw_control.modes import ModeDecision, ModeManager
+from dukw_control.modes import ModeDecision, ModeManager, ModeSettings
 from dukw_control.modes import settings_from_params as mode_settings
 
 #: the controller's timer steps when the estimator has been silent this many periods
@@ -50,9 +50,11 @@ class ModeManagerRunner:
         self.last_publish_s: float | None = None
 
     @classmethod
-    def from_params(cls, params: Mapping[str, ParamValue]) -> 'ModeManagerRunner':
-        """As mode_manager_node configures it (raises ValueError on bad settings)."""
-        return cls(ModeManager(mode_settings(params)), float(params['rate_hz']),
+    def from_params(cls, params: Mapping[str, ParamValue],
+                    settings: ModeSettings | None = None) -> 'ModeManagerRunner':
+        """As mode_manager_node configures it (raises ValueError on bad settings);
+        ``settings`` replaces the parameters' decision settings (tests, tuning)."""
+        return cls(ModeManager(settings or mode_settings(params)), float(params['rate_hz']),
                    float(params['republish_period_s']))
 
     # --- inputs (each as it arrives) ---------------------------------------------------
@@ -102,10 +104,12 @@ class DriveControllerRunner:
         self.last_event_step_s = -float('inf')
 
     @classmethod
-    def from_params(cls, params: Mapping[str, ParamValue]) -> 'DriveControllerRunner':
-        """As drive_controller_node configures it (raises ValueError on bad settings)."""
-        return cls(DriveController(controller_settings(params)), float(params['rate_hz']),
-                   bool(params.get('step_on_odometry', False)))
+    def from_params(cls, params: Mapping[str, ParamValue],
+                    settings: ControllerSettings | None = None) -> 'DriveControllerRunner':
+        """As drive_controller_node configures it (raises ValueError on bad settings);
+        ``settings`` replaces the parameters' control settings (tests, tuning)."""
+        return cls(DriveController(settings or controller_settings(params)),
+                   float(params['rate_hz']), bool(params.get('step_on_odometry', False)))
 
     # --- inputs (each as it arrives; some step at once) ---------------------------------
     def on_cmd_vel(self, speed_mps: float, yaw_rate_rps: float, now_s: float,
