@@ -25,6 +25,7 @@ import yaml
 
 from dukw_bringup.accuracy import ACCURACY_COLUMNS, accuracy
 from dukw_common.config import node_params
+from dukw_common.geometry import geodetic_from_local_enu
 
 KINDS = ('land_to_sea', 'sea_to_land', 'land_circle', 'water_circle')
 #: Drawn per run, in this order (the order is part of reproducibility: never reorder).
@@ -43,7 +44,6 @@ BOUNDS = {'significant_wave_height_m': (0.0, 1.0), 'peak_period_s': (1.0, 20.0),
           'sensor_seed': (0, 2 ** 32 - 1), 'yaw_rate_rps': (-1.5, 1.5)}
 FAULTS = {'gps_dropout': ('start_s', 'duration_s'), 'gps_outlier': ('start_s', 'offset_m')}
 TARGET_NAMES = ('slip_rmse', 'volume_error_pct', 'fraction_error', 'mode_delay_s')
-EARTH_RADIUS_M = 6_371_000.0
 
 
 class SpecError(ValueError):
@@ -282,10 +282,10 @@ class SensorFaults:
                 continue
             if kind == 'GpsFix' and self.outlier_s is not None and r.t_s >= self.outlier_s:
                 self.outlier_s = None           # one fix, thrown north-east by offset_m
-                d_deg = math.degrees(self.outlier_m / math.sqrt(2.0) / EARTH_RADIUS_M)
-                r = dataclasses.replace(r, latitude_deg=r.latitude_deg + d_deg,
-                                        longitude_deg=r.longitude_deg + d_deg / math.cos(
-                                            math.radians(r.latitude_deg)))
+                d_m = self.outlier_m / math.sqrt(2.0)
+                lat, lon, _ = geodetic_from_local_enu(d_m, d_m, 0.0, r.latitude_deg,
+                                                      r.longitude_deg, r.altitude_m)
+                r = dataclasses.replace(r, latitude_deg=lat, longitude_deg=lon)
             out.append(r)
         return out
 

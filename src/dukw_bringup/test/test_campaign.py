@@ -200,9 +200,9 @@ def test_gps_faults_drop_fixes_in_the_window_and_throw_one_outlier():
     assert faults([fix(1.2), GpsVelocity(1.2, 1.0, 0.0, 0.1, 0.0, 0.1)]) == []
     assert faults([fix(1.5)]) == [fix(1.5)]
     moved = faults([fix(2.0)])[0]
-    north_m = math.radians(moved.latitude_deg - 36.0) * campaign.EARTH_RADIUS_M
-    east_m = (math.radians(moved.longitude_deg + 75.0) * campaign.EARTH_RADIUS_M
-              * math.cos(math.radians(36.0)))
+    from dukw_common.geometry import local_enu_from_geodetic
+    east_m, north_m, _ = local_enu_from_geodetic(moved.latitude_deg, moved.longitude_deg, 0.0,
+                                                 36.0, -75.0, 0.0)
     assert math.hypot(north_m, east_m) == pytest.approx(10.0, rel=1e-3)
     assert faults([fix(2.1)]) == [fix(2.1)]           # one outlier only
 

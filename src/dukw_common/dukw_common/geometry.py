@@ -62,10 +62,14 @@ def rotate_world_to_body(yaw_rad: float, vx: float, vy: float) -> tuple:
     return c * vx + s * vy, -s * vx + c * vy
 
 
+#: WGS84 equatorial radius, m (the local tangent-plane approximation's scale)
+EARTH_RADIUS_M = 6378137.0
+
+
 def local_enu_from_geodetic(lat_deg: float, lon_deg: float, alt_m: float,
                             lat0_deg: float, lon0_deg: float, alt0_m: float) -> tuple:
     """Local tangent-plane (ENU) offset from a datum; equirectangular, fine over a few km."""
-    r_earth = 6378137.0
+    r_earth = EARTH_RADIUS_M
     east = math.radians(lon_deg - lon0_deg) * r_earth * math.cos(math.radians(lat0_deg))
     north = math.radians(lat_deg - lat0_deg) * r_earth
     return east, north, alt_m - alt0_m
@@ -74,7 +78,7 @@ def local_enu_from_geodetic(lat_deg: float, lon_deg: float, alt_m: float,
 def geodetic_from_local_enu(east_m: float, north_m: float, up_m: float,
                             lat0_deg: float, lon0_deg: float, alt0_m: float) -> tuple:
     """Inverse of local_enu_from_geodetic: (lat_deg, lon_deg, alt_m)."""
-    r_earth = 6378137.0
+    r_earth = EARTH_RADIUS_M
     lat = lat0_deg + math.degrees(north_m / r_earth)
     lon = lon0_deg + math.degrees(east_m / (r_earth * math.cos(math.radians(lat0_deg))))
     return lat, lon, alt0_m + up_m
