@@ -89,6 +89,7 @@ class ShoreSettings:
     datum: Datum
     current_limit_a: float
     mission_speed_mps: float
+    max_speed_mps: float             # the vehicle's top speed (drivetrain fact)
     radio_baud: int
     budget_fraction: float = 0.5
     system_id: int = 1
@@ -127,7 +128,8 @@ class ShoreLink:
         self.scheduler = RateScheduler(tuning.rates_hz)
         self.state = VehicleState()
         self.encoder = TelemetryEncoder(self.mav, settings.datum, settings.current_limit_a)
-        self.mission = MissionProtocol(self.mav, settings.datum, settings.mission_speed_mps)
+        self.mission = MissionProtocol(self.mav, settings.datum, settings.mission_speed_mps,
+                                       settings.max_speed_mps)
         self.mission_index = 0
         self.mission_reached = 0
         self.t0_s = now_s
@@ -518,7 +520,7 @@ def settings_from_params(p: dict) -> tuple[ShoreSettings, Tuning]:
     """ShoreSettings and Tuning from the node's parameters (config/dukw.yaml shore_link_node)."""
     datum = Datum(p['datum.latitude_deg'], p['datum.longitude_deg'], p['datum.altitude_m'])
     settings = ShoreSettings(datum, p['drivetrain.continuous_current_limit_a'],
-                             p['mission_speed_mps'],
+                             p['mission_speed_mps'], p['drivetrain.full_scale_track_speed_mps'],
                              int(p['radio_baud']), p['radio_budget_fraction'],
                              int(p['system_id']), int(p['component_id']))
     try:

@@ -28,6 +28,8 @@ PARAMS = [
     ParamSpec('diagnostics_period_s', '/diagnostics period, s', min=0.1, max=60.0),
     ParamSpec('drivetrain.continuous_current_limit_a', 'continuous motor current (the shared '
               'drivetrain fact; trk_i_pct), A', min=1.0, max=500.0),
+    ParamSpec('drivetrain.full_scale_track_speed_mps', 'top speed (the shared drivetrain '
+              'fact): DO_CHANGE_SPEED above it is refused, m/s', min=0.1, max=10.0),
     ParamSpec('mission_speed_mps', 'leg speed before any DO_CHANGE_SPEED, m/s', min=0.05,
               max=2.0),
     *(ParamSpec(f'datum.{n}', f'odom origin {n} (the shared datum.*)', min=lo, max=hi)

@@ -21,7 +21,6 @@ GLOBAL_FRAMES = frozenset({mavlink.MAV_FRAME_GLOBAL, mavlink.MAV_FRAME_GLOBAL_IN
                            mavlink.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT})
 MAX_ITEMS = 100
 #: The vehicle's speed range for a leg (mission.py accepts (0, 2] m/s).
-MAX_SPEED_MPS = 2.0
 
 
 @dataclass(frozen=True)
@@ -55,15 +54,16 @@ def _item_from_message(msg) -> MissionItem:
                        (msg.param1, msg.param2, msg.param3, msg.param4), x, y, msg.z)
 
 
-def plan_from_items(items: list[MissionItem], datum: Datum,
-                    default_speed_mps: float) -> tuple[list[PlanWaypoint], int]:
-    """Items -> waypoints; returns (waypoints, MAV_MISSION_RESULT)."""
+def plan_from_items(items: list[MissionItem], datum: Datum, default_speed_mps: float,
+                    max_speed_mps: float) -> tuple[list[PlanWaypoint], int]:
+    """Items -> waypoints; returns (waypoints, MAV_MISSION_RESULT). A DO_CHANGE_SPEED
+    above ``max_speed_mps`` (the vehicle's top speed) is refused."""
     speed = default_speed_mps
     plan = []
     for item in items:
         if item.command == mavlink.MAV_CMD_DO_CHANGE_SPEED:
             new_speed = item.params[1]
-            if not (0.0 < new_speed <= MAX_SPEED_MPS):
+            if not (0.0 < new_speed <= max_speed_mps):
                 return [], mavlink.MAV_MISSION_INVALID_PARAM2
             speed = new_speed
         elif item.command == mavlink.MAV_CMD_NAV_WAYPOINT:
@@ -84,10 +84,11 @@ class MissionProtocol:
     """Upload / download / clear with one ground station at a time; send() gets replies."""
 
     def __init__(self, mav: mavlink.MAVLink, datum: Datum, default_speed_mps: float,
-                 item_timeout_s: float = 1.5, retries: int = 5) -> None:
+                 max_speed_mps: float, item_timeout_s: float = 1.5, retries: int = 5) -> None:
         self.mav = mav
         self.datum = datum
         self.default_speed_mps = default_speed_mps
+        self.max_speed_mps = max_speed_mps
         self.item_timeout_s = item_timeout_s
         self.retries = retries
         self.items: list[MissionItem] = []
@@ -146,7 +147,8 @@ class MissionProtocol:
         if len(up['items']) < up['count']:
             return [self._request(len(up['items']))]
         self._upload = None
-        plan, result = plan_from_items(up['items'], self.datum, self.default_speed_mps)
+        plan, result = plan_from_items(up['items'], self.datum, self.default_speed_mps,
+                                       self.max_speed_mps)
         if result == mavlink.MAV_MISSION_ACCEPTED and not plan:
             result = mavlink.MAV_MISSION_INVALID   # a mission needs a waypoint
         if result == mavlink.MAV_MISSION_ACCEPTED:
