@@ -32,6 +32,7 @@ from dukw_control.controller import ControlOutput, ControllerSettings, DriveCont
 from dukw_control.controller import settings_from_params as controller_settings
 from dukw_control.modes import ModeDecision, ModeManager, ModeSettings
 from dukw_control.runners import DriveControllerRunner, ModeManagerRunner, ModePublication
+from dukw_estimation.runner import INPUTS as EKF_INPUTS
 from dukw_estimation.runner import EkfRunner, Estimate
 from dukw_estimation.samples import OdometryEstimate, TractionEstimate
 from dukw_control.convert import authority_usable
@@ -42,8 +43,7 @@ from dukw_sim.switch import RcChannels, SimServoSwitch
 from dukw_sim.truth import Truth
 
 MS_NS = 1_000_000
-SENSOR_TOPICS = frozenset(('imu/data', 'gps/fix', 'gps/vel', 'water/contact', 'depth',
-                           'tracks/status', 'props/status'))
+SENSOR_TOPICS = frozenset(EKF_INPUTS)     # the device topics (the EKF subscribes all)
 AUTHORITY_PERIOD_NS = 1_000 * MS_NS    # the servo switch re-sends authority every second
 
 #: offsets within a step, ns (see the module docstring)
