@@ -4,6 +4,7 @@ Row: the EKF process dies. Injected: SIGKILL to ekf_node while `bringup sim` dri
 mission. Must: the controller's tracks/cmd neutral within 0.5 s (pitch and traction
 stale) and the runner stops the stack with exit 1 naming the node.
 """
+import contextlib
 import re
 import signal
 import subprocess
@@ -21,25 +22,42 @@ TIMEOUT_S = 0.5                  # imu_timeout_s / traction_timeout_s (config)
 SLACK_S = 0.15
 
 
-def test_killed_ekf_ends_in_neutral_and_stops_the_stack():
-    runner = subprocess.Popen([str(executable('dukw_bringup', 'bringup')), 'sim', '--quiet'],
+@contextlib.contextmanager
+def running_stack(shape: str, node: str):
+    """``bringup SHAPE`` until ``node`` has started: yields (runner, its pid), then stops it."""
+    runner = subprocess.Popen([str(executable('dukw_bringup', 'bringup')), shape, '--quiet'],
                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         pids = {}
         deadline = time.monotonic() + 60.0
-        while len(pids) < 5 and time.monotonic() < deadline:
+        while node not in pids and time.monotonic() < deadline:
             match = re.search(r'started (\w+) \(pid (\d+)\)', runner.stdout.readline())
             if match:
                 pids[match.group(1)] = int(match.group(2))
+        yield runner, pids[node]
+    finally:
+        if runner.poll() is None:
+            runner.send_signal(signal.SIGINT)
+            runner.communicate(timeout=60)
+
+
+def kill_while_driving(pid: int, executor, tracks: list) -> float:
+    """Wait until the mission drives the tracks, SIGKILL ``pid``; the kill's time."""
+    assert spin_until(executor, lambda: tracks and abs(tracks[-1][1].stbd_pct) > 5.0,
+                      90.0), 'the mission never drove'
+    since = time.monotonic()
+    subprocess.run(['kill', '-KILL', str(pid)], check=True)
+    return since
+
+
+def test_killed_ekf_ends_in_neutral_and_stops_the_stack():
+    with running_stack('sim', 'ekf_node') as (runner, pid):
         tracks = []
         with ros_node('stack_probe') as (node, executor):
             node.create_subscription(DiffCommand, 'tracks/cmd',
                                      lambda m: tracks.append((time.monotonic(), m)),
                                      COMMAND_QOS)
-            assert spin_until(executor, lambda: tracks and abs(tracks[-1][1].stbd_pct) > 5.0,
-                              90.0), 'the mission never drove'
-            since = time.monotonic()
-            subprocess.run(['kill', '-KILL', str(pids['ekf_node'])], check=True)
+            since = kill_while_driving(pid, executor, tracks)
 
             def neutral_after():
                 return [t for t, m in tracks if t > since and m.port_pct == 0.0
@@ -49,10 +67,6 @@ def test_killed_ekf_ends_in_neutral_and_stops_the_stack():
         print(f'EKF killed -> neutral tracks: {reaction:.3f} s')
         assert reaction <= TIMEOUT_S + SLACK_S
         out, err = runner.communicate(timeout=60)
-    finally:
-        if runner.poll() is None:
-            runner.send_signal(signal.SIGINT)
-            runner.communicate(timeout=60)
     assert runner.returncode == 1
     assert 'ekf_node exited unexpectedly (killed by signal 9)' in out + err
 
@@ -61,16 +75,7 @@ def test_killed_composed_chain_ends_in_switch_neutral_and_stops_the_stack():
     """Composed shape (the main job's): the EKF shares its process with the controller, so
     killing it kills both; no command comes any more and the servo switch goes neutral
     on its command timeout (0.5 s; `authority` says COMMAND_TIMEOUT); bringup exits 1."""
-    runner = subprocess.Popen([str(executable('dukw_bringup', 'bringup')), 'sim_composed',
-                               '--quiet'], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                              text=True)
-    try:
-        pids = {}
-        deadline = time.monotonic() + 60.0
-        while 'control_chain' not in pids and time.monotonic() < deadline:
-            match = re.search(r'started (\w+) \(pid (\d+)\)', runner.stdout.readline())
-            if match:
-                pids[match.group(1)] = int(match.group(2))
+    with running_stack('sim_composed', 'control_chain') as (runner, pid):
         tracks, authority = [], []
         with ros_node('stack_probe') as (node, executor):
             node.create_subscription(DiffCommand, 'tracks/cmd',
@@ -79,10 +84,7 @@ def test_killed_composed_chain_ends_in_switch_neutral_and_stops_the_stack():
             node.create_subscription(Authority, 'authority',
                                      lambda m: authority.append((time.monotonic(), m)),
                                      STATE_QOS)
-            assert spin_until(executor, lambda: tracks and abs(tracks[-1][1].stbd_pct) > 5.0,
-                              90.0), 'the mission never drove'
-            since = time.monotonic()
-            subprocess.run(['kill', '-KILL', str(pids['control_chain'])], check=True)
+            since = kill_while_driving(pid, executor, tracks)
 
             def timed_out():
                 return [t for t, m in authority if t > since and m.outputs_neutral
@@ -92,9 +94,5 @@ def test_killed_composed_chain_ends_in_switch_neutral_and_stops_the_stack():
         print(f'composed chain killed -> switch neutral: {reaction:.3f} s')
         assert reaction <= TIMEOUT_S + SLACK_S + 0.1       # + the switch's status period
         out, err = runner.communicate(timeout=60)
-    finally:
-        if runner.poll() is None:
-            runner.send_signal(signal.SIGINT)
-            runner.communicate(timeout=60)
     assert runner.returncode == 1
     assert 'control_chain exited unexpectedly (killed by signal 9)' in out + err
