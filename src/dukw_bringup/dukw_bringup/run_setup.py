@@ -21,7 +21,7 @@ import datetime as dt
 import math
 import shutil
 import tempfile
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
@@ -131,14 +131,14 @@ def make_shore_key(path: Path) -> str:
 def with_shore_link(stack: StackSpec) -> StackSpec:
     """The stack with the shore link last (it needs a per-run key, so the stack files, which
     ``bringup`` and the launch file also start, do not list it)."""
-    return StackSpec(stack.name, (*stack.nodes, NodeSpec(SHORE_NODE, 'dukw_driver', SHORE_NODE)))
+    return replace(stack, nodes=(*stack.nodes, NodeSpec(SHORE_NODE, 'dukw_driver', SHORE_NODE)))
 
 
 def with_recorder(stack: StackSpec, bag_dir: Path) -> StackSpec:
     """The stack with the recorder first: it starts before and stops after every node."""
     recorder = NodeSpec(RECORDER, 'dukw_bringup', 'record',
                         cli_args=('--out', str(bag_dir), '--all'))
-    return StackSpec(stack.name, (recorder, *stack.nodes))
+    return replace(stack, nodes=(recorder, *stack.nodes))
 
 
 def format_progress(t_s: float, mode: str, progress: Progress | None, speed_mps: float,

@@ -14,7 +14,8 @@ from dukw_bringup.bringup import load_stack, node_executable, stack_path
 from dukw_bringup.mission import MissionState, Progress, load_mission, parse_mission
 from dukw_bringup.plots import PLOT_FILES
 from dukw_bringup.run_setup import (default_run_dir, format_progress, make_run_dir,
-                                    mission_document, prepare_run, with_recorder)
+                                    mission_document, prepare_run, with_recorder,
+                                    with_shore_link)
 from dukw_common.config import ConfigError, default_config_path, load_file
 
 SUMMARY_KEYS = ('reached', 'state', 'time_s', 'mode_timeline', 'track_currents',
@@ -50,6 +51,11 @@ def test_prepare_run_writes_config_mission_and_overlay(tmp_path):
         assert nodes[name]['use_sim_time'] is True
     assert nodes['mission_node']['mission_file'] == str(tmp_path / 'mission.yaml')
     assert stack.nodes[0].name == 'recorder'                 # first up, last down
+    sim = load_stack(stack_path('sim'))                      # the stack's graph settings stay
+    for extended in (stack, with_shore_link(stack)):
+        assert (extended.clock_node, extended.discovery_range) == (sim.clock_node,
+                                                                   sim.discovery_range)
+        assert extended.discovery_range == 'LOCALHOST'
     with pytest.raises(ConfigError, match='real-time factor'):
         prepare_run(tmp_path / 'x', default_config_path(), stack, spec, -1.0)
 
