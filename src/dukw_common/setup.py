@@ -15,6 +15,8 @@ setup(
         ('share/' + package_name + '/config', glob('config/*.yaml')),
         ('share/' + package_name + '/config/reference', glob('config/reference/*.yaml')),
         ('share/' + package_name + '/config/sros2', glob('config/sros2/*.xml')),
+        ('share/' + package_name + '/config/sros2/profiles',
+         glob('config/sros2/profiles/*.xml')),
     ],
     install_requires=['setuptools'],
     zip_safe=True,
