@@ -70,9 +70,17 @@ def segment_area_m2(depth_m: ArrayLike, radius_m: float) -> ArrayLike:
         h = r - min(max(float(depth_m), 0.0), 2.0 * r)
         return (r * r * float(np.arccos(min(max(h / r, -1.0), 1.0)))   # numpy: same bits
                 - h * math.sqrt(max(r * r - h * h, 0.0)))
-    d = np.clip(np.asarray(depth_m, dtype=float), 0.0, 2.0 * r)
-    h = r - d
-    return r * r * np.arccos(np.clip(h / r, -1.0, 1.0)) - h * np.sqrt(np.maximum(r * r - h * h, 0))
+    return _segment_area_array(np.asarray(depth_m, dtype=float), r)
+
+
+def _segment_area_array(depth_m: np.ndarray, r: float) -> np.ndarray:
+    """``segment_area_m2`` of an array: the simulator's strips every step, so its clips are
+    ufunc calls (np.clip's Python wrapper costs more than the arithmetic; same bits)."""
+    h = r - np.minimum(np.maximum(depth_m, 0.0), 2.0 * r)
+    cos_half = h / r
+    np.maximum(cos_half, -1.0, out=cos_half)
+    np.minimum(cos_half, 1.0, out=cos_half)
+    return r * r * np.arccos(cos_half) - h * np.sqrt(np.maximum(r * r - h * h, 0))
 
 
 def segment_area_integral_m3_per_m(depth_m: float, radius_m: float) -> float:
@@ -145,9 +153,9 @@ class HullSection:
             return (segment_area_m2(min(d, self.float_depth_m), self.radius_m)
                     + self.strut_width_m * max(d - self.float_depth_m, 0.0))
         d = np.minimum(np.asarray(depth_m, dtype=float), self.top_depth_m)
-        out = segment_area_m2(np.minimum(d, self.float_depth_m), self.radius_m) \
-            + self.strut_width_m * np.maximum(d - self.float_depth_m, 0.0)
-        return float(out) if np.ndim(out) == 0 else out
+        out = _segment_area_array(np.minimum(d, self.float_depth_m), self.radius_m)
+        out += self.strut_width_m * np.maximum(d - self.float_depth_m, 0.0)
+        return out
 
     def max_area_m2(self) -> float:
         """The whole section, deck awash (unbounded for a strut without a deck), m^2."""
