@@ -152,8 +152,19 @@ class HullSection:
             d = min(float(depth_m), self.top_depth_m)
             return (segment_area_m2(min(d, self.float_depth_m), self.radius_m)
                     + self.strut_width_m * max(d - self.float_depth_m, 0.0))
-        d = np.minimum(np.asarray(depth_m, dtype=float), self.top_depth_m)
-        out = _segment_area_array(np.minimum(d, self.float_depth_m), self.radius_m)
+        return self.area_array_m2(np.asarray(depth_m, dtype=float))
+
+    def area_array_m2(self, depth_m: np.ndarray) -> np.ndarray:
+        """``area_m2`` of a float array (the simulator's strips, every step), same bits.
+
+        The segment's clips fold into one: min(max(d, 0), min(float_depth, 2r)) selects the
+        same value as clipping min(d, float_depth) into [0, 2r], and then |r - d| <= r, so
+        the clip of (r - d) / r into [-1, 1] never acts (correctly rounded division).
+        """
+        r = self.radius_m
+        d = np.minimum(depth_m, self.top_depth_m)
+        h = r - np.minimum(np.maximum(d, 0.0), min(self.float_depth_m, 2.0 * r))
+        out = r * r * np.arccos(h / r) - h * np.sqrt(np.maximum(r * r - h * h, 0))
         out += self.strut_width_m * np.maximum(d - self.float_depth_m, 0.0)
         return out
 
