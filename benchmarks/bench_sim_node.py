@@ -10,6 +10,8 @@ achieved factor mostly measures the scheduler). Target (issue 3): >= 10x with al
 sensors published. Prints figures; no pass/fail.
 
     python benchmarks/bench_sim_node.py [--seconds 10] [--factors 0,10,20]
+    python benchmarks/bench_sim_node.py --profile-steps 3000   # cProfile of SimNode.step
+                                                               # in this process (no listener)
 """
 from __future__ import annotations
 
@@ -89,12 +91,47 @@ def run(factor: float, seconds: float, executor: str) -> dict:
             'exit': code}
 
 
+def profile_steps(steps: int) -> None:
+    """CPU time per SimNode.step in this process (publishing, no subscriber), then cProfile's
+    top entries: where a step of the node goes besides the core and the sensors."""
+    import cProfile
+    import pstats
+
+    from dukw_sim.sim_node import SimNode
+    rclpy.init(args=['--ros-args', '-p', 'real_time_factor:=0.0'])
+    try:
+        node = SimNode()
+        node.switch.command('tracks', 50.0, 48.0, 0.0)
+        for _ in range(100):
+            node.step()
+        cpu0 = time.process_time()
+        for _ in range(steps):
+            node.step()
+        per_step_us = (time.process_time() - cpu0) / steps * 1e6
+        print(f'SimNode.step in process: {per_step_us:.1f} us CPU per step '
+              f'({1e6 / per_step_us / 100:.1f}x real time per core at 100 Hz)')
+        profiler = cProfile.Profile()
+        profiler.enable()
+        for _ in range(steps):
+            node.step()
+        profiler.disable()
+        pstats.Stats(profiler).sort_stats('tottime').print_stats(40)
+        node.destroy_node()
+    finally:
+        rclpy.shutdown()
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--seconds', type=float, default=10.0, help='measured wall seconds')
     parser.add_argument('--factors', default='0,10,20', help='real_time_factor values')
     parser.add_argument('--executors', default='events', help='sim_node executors: events,single')
+    parser.add_argument('--profile-steps', type=int, default=0,
+                        help='only profile this many SimNode.step calls in this process')
     args = parser.parse_args(argv)
+    if args.profile_steps > 0:
+        profile_steps(args.profile_steps)
+        return 0
     print(f'load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores')
     print(f'{"executor":<8} {"asked":>6} {"achieved":>9} {"msgs/s":>8} {"sim CPU":>8} '
           f'{"per core":>9}')

@@ -70,9 +70,17 @@ def segment_area_m2(depth_m: ArrayLike, radius_m: float) -> ArrayLike:
         h = r - min(max(float(depth_m), 0.0), 2.0 * r)
         return (r * r * float(np.arccos(min(max(h / r, -1.0), 1.0)))   # numpy: same bits
                 - h * math.sqrt(max(r * r - h * h, 0.0)))
-    d = np.clip(np.asarray(depth_m, dtype=float), 0.0, 2.0 * r)
-    h = r - d
-    return r * r * np.arccos(np.clip(h / r, -1.0, 1.0)) - h * np.sqrt(np.maximum(r * r - h * h, 0))
+    return _segment_area_array(np.asarray(depth_m, dtype=float), r)
+
+
+def _segment_area_array(depth_m: np.ndarray, r: float) -> np.ndarray:
+    """``segment_area_m2`` of an array: the simulator's strips every step, so its clips are
+    ufunc calls (np.clip's Python wrapper costs more than the arithmetic; same bits)."""
+    h = r - np.minimum(np.maximum(depth_m, 0.0), 2.0 * r)
+    cos_half = h / r
+    np.maximum(cos_half, -1.0, out=cos_half)
+    np.minimum(cos_half, 1.0, out=cos_half)
+    return r * r * np.arccos(cos_half) - h * np.sqrt(np.maximum(r * r - h * h, 0))
 
 
 def segment_area_integral_m3_per_m(depth_m: float, radius_m: float) -> float:
@@ -144,10 +152,21 @@ class HullSection:
             d = min(float(depth_m), self.top_depth_m)
             return (segment_area_m2(min(d, self.float_depth_m), self.radius_m)
                     + self.strut_width_m * max(d - self.float_depth_m, 0.0))
-        d = np.minimum(np.asarray(depth_m, dtype=float), self.top_depth_m)
-        out = segment_area_m2(np.minimum(d, self.float_depth_m), self.radius_m) \
-            + self.strut_width_m * np.maximum(d - self.float_depth_m, 0.0)
-        return float(out) if np.ndim(out) == 0 else out
+        return self.area_array_m2(np.asarray(depth_m, dtype=float))
+
+    def area_array_m2(self, depth_m: np.ndarray) -> np.ndarray:
+        """``area_m2`` of a float array (the simulator's strips, every step), same bits.
+
+        The segment's clips fold into one: min(max(d, 0), min(float_depth, 2r)) selects the
+        same value as clipping min(d, float_depth) into [0, 2r], and then |r - d| <= r, so
+        the clip of (r - d) / r into [-1, 1] never acts (correctly rounded division).
+        """
+        r = self.radius_m
+        d = np.minimum(depth_m, self.top_depth_m)
+        h = r - np.minimum(np.maximum(d, 0.0), min(self.float_depth_m, 2.0 * r))
+        out = r * r * np.arccos(h / r) - h * np.sqrt(np.maximum(r * r - h * h, 0))
+        out += self.strut_width_m * np.maximum(d - self.float_depth_m, 0.0)
+        return out
 
     def max_area_m2(self) -> float:
         """The whole section, deck awash (unbounded for a strut without a deck), m^2."""

@@ -10,4 +10,7 @@ import numpy as np
 
 def is_scalar(value) -> bool:
     """A plain number (float, int, numpy scalar or 0-d array): the scalar path applies."""
-    return isinstance(value, (float, int)) or np.ndim(value) == 0
+    if isinstance(value, (float, int)):
+        return True
+    ndim = getattr(value, 'ndim', None)      # arrays and numpy scalars: no np.ndim call
+    return np.ndim(value) == 0 if ndim is None else ndim == 0

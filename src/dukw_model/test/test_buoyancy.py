@@ -145,6 +145,11 @@ def test_the_scalar_section_gives_the_array_section_bit_for_bit():
 
     from dukw_model.buoyancy import HullSection, segment_area_m2
     section = HullSection(0.3, 0.45, 0.2, 0.9)
-    for depth in np.random.default_rng(5).uniform(-0.2, 1.2, 5000):
+    edges = [0.0, -0.0, 0.6, 0.45, 0.9, 1e-300, 0.6 - 1e-16]   # clip and section limits
+    for depth in [*edges, *np.random.default_rng(5).uniform(-0.2, 1.2, 5000)]:
         assert segment_area_m2(float(depth), 0.3) == segment_area_m2(np.array([depth]), 0.3)[0]
         assert section.area_m2(float(depth)) == section.area_m2(np.array([depth]))[0]
+    # the array path folds the clips: a float line at the top of the circle, and none
+    for other in (HullSection(0.3, 0.6, 0.2), HullSection(0.3, 0.0, 0.1, 0.5)):
+        depths = np.array([*edges, *np.random.default_rng(6).uniform(-0.2, 1.2, 2000)])
+        assert [other.area_m2(float(d)) for d in depths] == other.area_array_m2(depths).tolist()

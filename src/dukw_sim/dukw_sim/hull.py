@@ -75,7 +75,7 @@ class HullGeometry:
         d = depth_over_bottom_m
         if d.max() <= 0.0:
             return self._dry
-        return self.section.area_m2(d)
+        return self.section.area_array_m2(d)
 
 
 @dataclass(frozen=True)

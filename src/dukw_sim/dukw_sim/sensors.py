@@ -53,6 +53,19 @@ class Fault(IntFlag):
         return tuple(f.name.lower() for f in Fault if f in self)
 
 
+#: FAULT_* bits -> their names, filled as combinations occur (a per-sample enum walk costs
+#: more than the rest of a motor channel's model)
+_FAULT_NAMES: dict[int, tuple[str, ...]] = {}
+
+
+def fault_names(bits: int) -> tuple[str, ...]:
+    """``Fault(bits).names()``, cached."""
+    names = _FAULT_NAMES.get(bits)
+    if names is None:
+        names = _FAULT_NAMES[bits] = Fault(bits).names()
+    return names
+
+
 # ----------------------------------------------------------------------------- settings
 
 @dataclass(frozen=True)
@@ -229,13 +242,19 @@ class GaussMarkov:
         self.tau_s = tau_s
         self.value = std * first_draw
 
+    _coeffs = (math.nan, 0.0, 0.0)   # (dt_s, a, sqrt(1 - a^2) std) of the last step's dt
+
     def step(self, dt_s: float, draw: float) -> float:
         """Advance by ``dt_s`` with a fresh N(0, 1) draw; return the error."""
         if self.tau_s <= 0.0:
             self.value = self.std * draw
         elif dt_s > 0.0:
-            a = math.exp(-dt_s / self.tau_s)
-            self.value = a * self.value + math.sqrt(1.0 - a * a) * self.std * draw
+            last_dt, a, gain = self._coeffs
+            if dt_s != last_dt:        # a stream's dt is its fixed period: computed once
+                a = math.exp(-dt_s / self.tau_s)
+                gain = math.sqrt(1.0 - a * a) * self.std
+                self._coeffs = (dt_s, a, gain)
+            self.value = a * self.value + gain * draw
         return self.value
 
 
@@ -289,6 +308,9 @@ class _Debounce:
         return self.state
 
 
+_OVERHEAT, _UNDERVOLTAGE, _STALL = int(Fault.OVERHEAT), int(Fault.UNDERVOLTAGE), int(Fault.STALL)
+
+
 class _MotorChannel:
     """Controller temperature (first-order in I^2) and stall timer of one motor channel."""
 
@@ -298,20 +320,21 @@ class _MotorChannel:
         self.stalled_s = 0.0
 
     def update(self, dt_s: float, current_a: float, stalling: bool, voltage_v: float,
-               undervoltage_v: float) -> Fault:
-        """Advance temperature and stall timer by ``dt_s``; return the FAULT_* bits."""
+               undervoltage_v: float) -> int:
+        """Advance temperature and stall timer by ``dt_s``; return the FAULT_* bits (int:
+        IntFlag arithmetic per sample costs more than the model)."""
         m = self.settings
         target_c = m.ambient_temp_c + m.temp_rise_c_per_a2 * current_a * current_a
         share = min(1.0, dt_s / m.thermal_tau_s) if m.thermal_tau_s > 0 else 1.0
         self.temperature_c += (target_c - self.temperature_c) * share
         self.stalled_s = self.stalled_s + dt_s if stalling else 0.0
-        flags = Fault(0)
+        flags = 0
         if self.temperature_c >= m.overheat_c:
-            flags |= Fault.OVERHEAT
+            flags |= _OVERHEAT
         if voltage_v < undervoltage_v:
-            flags |= Fault.UNDERVOLTAGE
+            flags |= _UNDERVOLTAGE
         if stalling and self.stalled_s >= m.stall_time_s:
-            flags |= Fault.STALL
+            flags |= _STALL
         return flags
 
 
@@ -346,6 +369,10 @@ class SensorModel:
         hor, ver, tau = noise.gps_horizontal_std_m, noise.gps_vertical_std_m, noise.gps_tau_s
         self._gps_error = [GaussMarkov(hor, tau, first[6]), GaussMarkov(hor, tau, first[7]),
                            GaussMarkov(ver, tau, first[8])]
+        g, sx, sy, sz = (noise.gyro_std_rps, noise.accel_x_std_mps2, noise.accel_y_std_mps2,
+                         noise.accel_z_std_mps2)
+        self._imu_var = (noise.heading_std_rad ** 2, g * g, noise.attitude_std_rad ** 2,
+                         (sx * sx, sy * sy, sz * sz))   # the IMU's constant variances
         self._schedule = Schedule({name: getattr(cfg.rates, f'{name}_hz')
                                    for name in SENSOR_STREAMS})
         self._last_t: dict[str, float] = {}
@@ -400,14 +427,14 @@ class SensorModel:
             (alpha_x, alpha_y), h)
         bias, g = self._gyro_bias, noise.gyro_std_rps
         sx, sy, sz = noise.accel_x_std_mps2, noise.accel_y_std_mps2, noise.accel_z_std_mps2
-        att2, head2 = noise.attitude_std_rad ** 2, noise.heading_std_rad ** 2
+        head2, g2, att2, accel_var = self._imu_var
         return ImuSample(
             truth.t_s, truth.roll_rad + err[0], truth.pitch_rad + err[1], truth.yaw_rad + err[2],
             wx + bias[0] + g * d[0], wy + bias[1] + g * d[1], wz + bias[2] + g * d[2],
             fx + sx * d[3], fy + sy * d[4], fz + sz * d[5],
-            yaw_var_rad2=head2, yaw_rate_var_rps2=g * g, roll_var_rad2=att2,
-            pitch_var_rad2=att2, roll_rate_var_rps2=g * g, pitch_rate_var_rps2=g * g,
-            accel_var_m2ps4=(sx * sx, sy * sy, sz * sz))
+            yaw_var_rad2=head2, yaw_rate_var_rps2=g2, roll_var_rad2=att2,
+            pitch_var_rad2=att2, roll_rate_var_rps2=g2, pitch_rate_var_rps2=g2,
+            accel_var_m2ps4=accel_var)
 
     def antenna_enu(self, truth: Truth) -> tuple[float, float, float]:
         """True position of the GPS antenna in odom (ENU), m: base_link + R (0, 0, h)."""
@@ -495,12 +522,12 @@ class SensorModel:
             stalling = (speeds is not None and commands[i] != 0.0
                         and abs(currents[i]) >= stall.stall_current_a
                         and abs(true_speed) < stall.stall_speed_mps)
-            flags = self._motors[drive, side].update(dt, currents[i], stalling, voltage, under_v)
+            channel = self._motors[drive, side]
+            flags = channel.update(dt, currents[i], stalling, voltage, under_v)
             current = currents[i] + noise.current_std_a * d[3 * i]
             speed = 0.0 if speeds is None else true_speed + noise.speed_std_mps * d[3 * i + 1]
             sides.append(MotorSide(
                 commands[i], current, speed, force_n(current, commands[i]),
-                voltage_v=voltage + noise.voltage_std_v * d[3 * i + 2],
-                temperature_c=self._motors[drive, side].temperature_c,
-                fault_flags=int(flags), faults=flags.names()))
-        return DriveStatus(truth.t_s, sides[0], sides[1], connected=True, drive=drive)
+                voltage + noise.voltage_std_v * d[3 * i + 2], channel.temperature_c,
+                flags, fault_names(flags)))
+        return DriveStatus(truth.t_s, sides[0], sides[1], True, drive)

@@ -21,9 +21,10 @@ from diagnostic_msgs.msg import DiagnosticArray
 from dukw_msgs.msg import Authority, Depth, DrivetrainStatus, RcInput, SimTruth
 from dukw_msgs.msg import MotorSide as MotorSideMsg
 from dukw_msgs.msg import WaterContact as WaterContactMsg
-from geometry_msgs.msg import TwistWithCovarianceStamped
+from geometry_msgs.msg import TransformStamped, TwistWithCovarianceStamped
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, NavSatFix, NavSatStatus
+from tf2_msgs.msg import TFMessage
 
 from dukw_common.geometry import quaternion_from_euler
 from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS
@@ -66,6 +67,12 @@ def set_time(time_msg, t_s: float) -> None:
 def set_stamp(header, t_s: float) -> None:
     """Write sim time ``t_s`` (seconds) into ``header.stamp``."""
     set_time(header.stamp, t_s)
+
+
+def set_stamp_as_s_to_stamp(time_msg, t_s: float) -> None:
+    """``t_s`` into a builtin_interfaces/Time in place, as dukw_common's s_to_stamp rounds."""
+    sec = int(t_s // 1)
+    time_msg.sec, time_msg.nanosec = sec, int(round((t_s - sec) * 1e9)) % 1_000_000_000
 
 
 def _given(var: float) -> float:
@@ -119,6 +126,7 @@ class SimMessages:
         self._truth = SimTruth()
         self._truth.header.frame_id = frames.odom
         self._clock = Clock()
+        self._truth_tf: TFMessage | None = None
         self._by_type = {ImuSample: self.imu, GpsFix: self.gps_fix,
                          GpsVelocity: self.gps_velocity, WaterContact: self.water_contact,
                          DepthReading: self.depth}
@@ -236,6 +244,23 @@ class SimMessages:
         for name in _TRUTH_FIELDS:
             setattr(msg, name, float(getattr(t, name)))
         msg.medium = int(t.medium)
+        return msg
+
+    def truth_tf(self, t: Truth, child_frame: str) -> TFMessage:
+        """tf2_msgs/TFMessage odom -> ``child_frame`` at the true pose (what tf_tools'
+        tf_message(pose_transform(...)) gives, one message updated in place: building it
+        afresh per step cost as much as the rest of the step's messages)."""
+        msg = self._truth_tf
+        if msg is None or msg.transforms[0].child_frame_id != child_frame:
+            tf = TransformStamped()
+            tf.header.frame_id, tf.child_frame_id = self.frames.odom, child_frame
+            msg = self._truth_tf = TFMessage(transforms=[tf])
+        tf = msg.transforms[0]
+        set_stamp_as_s_to_stamp(tf.header.stamp, t.t_s)
+        p, q = tf.transform.translation, tf.transform.rotation
+        p.x, p.y, p.z = float(t.x_m), float(t.y_m), float(t.z_m)
+        q.x, q.y, q.z, q.w = (float(v) for v in quaternion_from_euler(t.roll_rad, t.pitch_rad,
+                                                                      t.yaw_rad))
         return msg
 
     def clock(self, t_s: float) -> Clock:

@@ -11,11 +11,10 @@ from rclpy.node import Node
 from tf2_msgs.msg import TFMessage
 
 from dukw_common.config import ConfigError
-from dukw_common.description import pose_transform
 from dukw_common.diagnostics import Level
 from dukw_common.node_tools import (COMMAND_QOS, declare_parameters, diagnostic_array,
-                                    publisher_sources, run_node, s_to_stamp)
-from dukw_common.tf_tools import TF_QOS, tf_message
+                                    publisher_sources, run_node)
+from dukw_common.tf_tools import TF_QOS
 from dukw_driver.authority import CommandGate
 from dukw_sim.core import Actuation, SimCore
 from dukw_sim.runtime import Pacer, SpeedMeter, sim_healths
@@ -118,10 +117,7 @@ class SimNode(Node):
     def publish_truth_tf(self) -> None:
         """odom -> frames.truth: the true pose beside the estimate's odom -> base_link."""
         if self.truth_tf_pub is not None:
-            t = self.truth
-            pose = pose_transform(self.msgs.frames.odom, self.params['frames.truth'], t.x_m,
-                                  t.y_m, t.z_m, t.roll_rad, t.pitch_rad, t.yaw_rad)
-            self.truth_tf_pub.publish(tf_message([pose], s_to_stamp(t.t_s)))
+            self.truth_tf_pub.publish(self.msgs.truth_tf(self.truth, self.params['frames.truth']))
 
     def diagnostics(self):
         """Simulator speed, authority, and every topic's rate (Hz of sim time)."""

@@ -151,6 +151,24 @@ def test_every_sim_truth_field_is_filled_from_truth():
     assert msg.medium == SimTruth.MEDIUM_WATER and msg.header.frame_id == 'odom'
 
 
+def test_truth_tf_in_place_is_the_fresh_tf_message_bit_for_bit():
+    """sim_node's cached odom -> truth TF must be what tf_message(pose_transform) builds
+    (repr: every float's shortest exact form, -0.0 too; CDR padding bytes are not set)."""
+    from dukw_common.description import pose_transform
+    from dukw_common.node_tools import s_to_stamp
+    from dukw_common.tf_tools import tf_message
+    msgs = SimMessages(FRAMES)
+    for k, t_s in enumerate([0.0, 0.01, 1.005, 2.9999999999, 123.456789]):
+        truth = Truth(t_s=t_s, x_m=1.5 + k, y_m=-0.25 * k, z_m=-0.1, roll_rad=0.02 * k,
+                      pitch_rad=-0.03, yaw_rad=2.5 - k)
+        fresh = tf_message([pose_transform('odom', 'base_link_truth', truth.x_m, truth.y_m,
+                                           truth.z_m, truth.roll_rad, truth.pitch_rad,
+                                           truth.yaw_rad)], s_to_stamp(t_s))
+        cached = msgs.truth_tf(truth, 'base_link_truth')
+        assert cached == fresh and repr(cached) == repr(fresh), t_s
+    assert msgs.truth_tf(truth, 'other').transforms[0].child_frame_id == 'other'
+
+
 def test_rc_authority_and_clock_messages():
     msgs = SimMessages(FRAMES)
     rc = msgs.rc_input(RcPulses(4.0, True, True, (1350.0, 1600.0)))
