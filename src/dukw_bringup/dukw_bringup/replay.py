@@ -110,11 +110,14 @@ class _Driver:
     def compare(self, topic: str, t_ns: int, msg: Any) -> None:
         recorded = self.adapter.recorded(topic, msg)
         replayed = self.latest or {}
+        deviations, angles, isnan = self.deviations, self.adapter.angle_quantities, math.isnan
         for quantity, value in recorded.items():
-            dev = self.deviations.setdefault(quantity, Deviation(self.adapter.name, quantity))
+            dev = deviations.get(quantity)
+            if dev is None:     # (not setdefault: it would build a Deviation every time)
+                dev = deviations[quantity] = Deviation(self.adapter.name, quantity)
             mine = replayed.get(quantity, math.nan)
-            diff = 0.0 if math.isnan(mine) and math.isnan(value) else abs(mine - value)
-            if quantity in self.adapter.angle_quantities and diff > math.pi:
+            diff = 0.0 if isnan(mine) and isnan(value) else abs(mine - value)
+            if diff > math.pi and quantity in angles:
                 diff = abs(math.remainder(mine - value, math.tau))
             dev.compared += 1
             worse = (dev.compared == 1 or diff > dev.max_abs

@@ -108,6 +108,7 @@ class EkfNode(Node):
         if refusal:                                # one client (the operator's) or none
             response.success, response.message = False, refusal
             return response
+        self.runner.seal()                         # (a held estimate keeps its traction)
         response.success = self.estimator.set_pose(request.x_m, request.y_m, request.yaw_rad)
         response.message = 'pose set' if response.success else 'refused: non-finite pose'
         return response
