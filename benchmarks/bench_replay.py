@@ -15,7 +15,8 @@ from pathlib import Path
 
 from dukw_bringup import bag_io
 from dukw_bringup.replay import replay, stream
-from dukw_bringup.replay_adapters import ADAPTERS
+from dukw_bringup.replay_adapters import ADAPTERS, EkfAdapter
+from dukw_estimation import ros_convert
 from figures import report
 
 GOLDEN = Path(__file__).resolve().parents[1] / 'tests' / 'golden'
@@ -46,6 +47,53 @@ def write_synthetic(path: Path, n_messages: int) -> float:
             topic = topics[k % len(topics)]
             writer.write(topic, k * 1_000_000, raws[topic])
     return time.perf_counter() - start
+
+
+def estimator_bound(bag: Path) -> tuple[float, dict[str, tuple[int, float]]]:
+    """The estimator's own work in a replay of ``bag``: its inputs decoded and converted
+    beforehand, only EkfRunner.on_sample/tick and the estimate's reads (odometry and
+    traction, as the replay compares both) timed. Returns (seconds, per input topic:
+    (count, seconds)); no replay through the cores can beat it."""
+    store = bag_io.typestore()
+    adapter = EkfAdapter()
+    with bag_io.BagReader(bag) as reader:
+        convert, stamp_or = ros_convert.SAMPLE_FROM_MSG, ros_convert.stamp_or
+        samples = [(key, t_s, convert[key](msg, stamp_or(msg, t_s)))
+                   for key, t_s, msg in ((bag_io.topic_key(m.topic), m.timestamp_ns * 1e-9,
+                                          bag_io.deserialize(m, store))
+                                         for m in reader.messages(EkfAdapter.inputs))]
+    runner, clock = adapter.runner, time.perf_counter
+    per_topic: dict[str, tuple[int, float]] = {}
+    next_tick_s, period_s = samples[0][1], 1.0 / adapter.rate_hz
+    for key, t_s, sample in samples:
+        start = clock()
+        while next_tick_s < t_s:              # the timer, as the replay runs it
+            estimate = runner.tick(next_tick_s)
+            if estimate is not None:
+                _ = estimate.odometry, estimate.traction
+            next_tick_s += period_s
+        estimate = runner.on_sample(key, sample, t_s)
+        if estimate is not None:
+            _ = estimate.odometry, estimate.traction
+        count, seconds = per_topic.get(key, (0, 0.0))
+        per_topic[key] = (count + 1, seconds + clock() - start)
+    return sum(s for _, s in per_topic.values()), per_topic
+
+
+def print_bound(bag: Path, messages: int, rate: float) -> None:
+    """What the estimator alone allows through all the cores, and its cost per class."""
+    seconds, per_topic = min((estimator_bound(bag) for _ in range(3)), key=lambda r: r[0])
+    imu = per_topic.get('imu/data', (0, 0.0))
+    print(f'bound   : {bag.name:<16} the estimator alone takes {seconds * 1e3:.1f} ms of the '
+          f'{messages} messages = at most {messages / seconds:,.0f} messages/s through all '
+          f'cores (reached {rate / (messages / seconds):.0%} of it); imu/data is '
+          f'{imu[0] / messages:.0%} of the messages at {imu[1] / max(imu[0], 1) * 1e6:.0f} us '
+          'each (step + odometry + traction)')
+    print('          per class (us each): ' + ', '.join(
+        f'{key} {s / n * 1e6:.0f} (x{n})' for key, (n, s) in
+        sorted(per_topic.items(), key=lambda item: -item[1][1])))
+    report(f'replay {bag.name} estimator-alone bound', messages / seconds, 'msg/s',
+           better='higher')
 
 
 def main() -> None:
@@ -83,6 +131,7 @@ def main() -> None:
               f'{result.elapsed_s:.3f} s = {result.rate_msgs_per_s:,.0f} messages/s')
         report(f'replay {bag.name} through all cores', result.rate_msgs_per_s, 'msg/s',
                target=50_000.0, better='higher')
+        print_bound(bag, result.messages, result.rate_msgs_per_s)
 
 
 if __name__ == '__main__':

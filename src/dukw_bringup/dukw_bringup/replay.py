@@ -159,17 +159,24 @@ def _replay(reader: BagReader, bag: Path, adapters: Sequence[CoreAdapter],
                            f'{adapter.name} replay on')
     drivers = [_Driver(a, min(firsts[o] for o in a.outputs if o in firsts)) for a in adapters]
     wanted = outputs.union(*(a.inputs for a in adapters))
+    routes: dict[str, tuple[str, list[tuple[_Driver, bool, bool]]]] = {}
+    decode = store.deserialize_cdr       # (bag_io.deserialize without its per-call lookup)
     start = time.perf_counter()
-    for message in reader.messages(wanted):
-        key = topic_key(message.topic)
-        t_ns = message.timestamp_ns
-        msg = deserialize(message, store)
+    for topic, msgtype, t_ns, raw in reader.messages(wanted):
+        route = routes.get(topic)
+        if route is None:                # each topic's key and which driver does what
+            key = topic_key(topic)
+            route = routes[topic] = (key, [(d, key in d.adapter.inputs, key in d.adapter.outputs)
+                                           for d in drivers])
+        key, steps = route
+        msg = decode(raw, msgtype)
         result.messages += 1
-        for driver in drivers:
-            driver.run_ticks_until(t_ns, inclusive=False)
-            if key in driver.adapter.inputs:
+        for driver, feeds, compares in steps:
+            if driver.next_tick_ns is not None and driver.next_tick_ns < t_ns:
+                driver.run_ticks_until(t_ns, inclusive=False)
+            if feeds:
                 driver.feed(key, t_ns, msg)
-            if key in driver.adapter.outputs:
+            if compares:
                 driver.run_ticks_until(t_ns, inclusive=True)
                 driver.compare(key, t_ns, msg)
     result.elapsed_s = time.perf_counter() - start
