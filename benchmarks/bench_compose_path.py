@@ -26,6 +26,7 @@ from rclpy.serialization import deserialize_message
 from dukw_bringup import bag_io, compose
 from dukw_common.config import default_config_path
 from figures import report
+from profile_text import profile_to_text
 
 GOLDEN = Path(__file__).resolve().parents[1] / 'tests' / 'golden'
 CHAIN = ['ekf_node', 'mode_manager_node', 'drive_controller_node']
@@ -75,23 +76,40 @@ def feed(bag: Path, nodes) -> dict[str, np.ndarray]:
     return {k: np.array(v) for k, v in times.items()}
 
 
+def one_pass(bag: Path, profile: str | None = None) -> dict[str, np.ndarray]:
+    """A fresh composed chain fed the whole bag (the feeding cProfiled to ``profile``)."""
+    nodes = compose.build(CHAIN)
+    try:
+        if profile:
+            return profile_to_text(lambda: feed(bag, nodes), profile, PROFILE_HEADER)
+        return feed(bag, nodes)
+    finally:
+        for node in reversed(nodes):
+            node.destroy_node()
+
+
+PROFILE_HEADER = """cProfile of the composed chain's path (a golden bag through its callbacks):
+  python benchmarks/bench_compose_path.py --profile benchmarks/profiles/compose_path.txt
+The command goes out before the observers' work: in the IMU callback the EKF step,
+odometry() and the filled Odometry's publication, then the controller's step and
+tracks/cmd + props/cmd; only then the traction read (Estimate.traction, lazy), /tf
+and traction. rclpy publish (C: serialisation + Fast DDS write) is the largest
+single item; the EKF's add_imu the largest Python one."""
+
+
 def main() -> None:
     """Print the path's percentiles."""
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     parser.add_argument('--bag', default='land_to_sea', help='golden bag (tests/golden)')
     parser.add_argument('--repeat', type=int, default=3, help='passes over the bag')
+    parser.add_argument('--profile', default=None,
+                        help='cProfile the passes, statistics as text to this file')
     args = parser.parse_args()
     rclpy.init(args=['--ros-args', '--params-file', str(default_config_path()),
                      '-p', 'traction_rate_hz:=20.0'])   # as config/stack_sim_composed.yaml
     try:
-        runs = []
-        for _ in range(args.repeat):
-            nodes = compose.build(CHAIN)
-            try:
-                runs.append(feed(GOLDEN / args.bag, nodes))
-            finally:
-                for node in reversed(nodes):
-                    node.destroy_node()
+        runs = [one_pass(GOLDEN / args.bag, args.profile if k == 0 else None)
+                for k in range(args.repeat)]
     finally:
         rclpy.try_shutdown()
     times = {k: np.concatenate([r[k] for r in runs]) * 1e3 for k in runs[0]}

@@ -18,6 +18,7 @@ from dukw_bringup.replay import replay, stream
 from dukw_bringup.replay_adapters import ADAPTERS, EkfAdapter
 from dukw_estimation import ros_convert
 from figures import report
+from profile_text import profile_to_text
 
 GOLDEN = Path(__file__).resolve().parents[1] / 'tests' / 'golden'
 #: replays of each golden bag through all cores (the best is reported: shared machine)
@@ -98,11 +99,32 @@ def print_bound(bag: Path, messages: int, rate: float) -> None:
            better='higher')
 
 
+PROFILE_HEADER = """cProfile of one replay of tests/golden/land_to_sea through all cores:
+  python benchmarks/bench_replay.py --profile benchmarks/profiles/replay_through_cores.txt
+Before issue 16's replay work the bag was opened twice (anchor pass + replay) and one
+open (metadata.yaml and every topic's QoS YAML, pure-Python ruamel) was timed with the
+messages: 40-80 ms per open, more than a quarter of a 7 s bag's replay. Now: one open,
+timed apart (bag_io.BagReader, ReplayResult.open_s). What is left is the estimator
+(estimator.py add_imu/add_tracks, contact.py submersion, dukw_model buoyancy: about
+half of the CPU), rosbags' CDR decoding and MCAP reading (~15 %), the controller's
+step (~7 %), the comparisons (~4 %). bench_replay's 'bound' line gives the
+estimator-alone limit per bag."""
+
+
 def main() -> None:
     """Print the throughput figures."""
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     parser.add_argument('--messages', type=int, default=200_000)
+    parser.add_argument('--profile', default=None,
+                        help='cProfile one replay of land_to_sea through all cores, as text '
+                             'to this file, and stop')
     args = parser.parse_args()
+    if args.profile:
+        replay(GOLDEN / 'land_to_sea', [f() for f in ADAPTERS.values()])  # rosbags' codegen
+        adapters = [f() for f in ADAPTERS.values()]
+        profile_to_text(lambda: replay(GOLDEN / 'land_to_sea', adapters), args.profile,
+                        PROFILE_HEADER)
+        return
     with tempfile.TemporaryDirectory() as tmp:
         bag = Path(tmp) / 'synthetic'
         seconds = write_synthetic(bag, args.messages)
