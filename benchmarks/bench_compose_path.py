@@ -8,6 +8,8 @@ bag's messages through its own subscriptions' callbacks, in bag order. For each 
 it times, on the thread's CPU clock (preemption by other processes does not count) and on
 the wall clock, from the callback's entry to the return of the tracks/cmd publication, and
 to the end of the callback (the observers' topics, published after the command).
+The nodes run on the wall clock, so the bag's stamped inputs (cmd_vel, authority) are stale
+to them and the controller steps to neutral: its mixing (~10 us) is not in the figure.
 
     python benchmarks/bench_compose_path.py [--bag land_to_sea] [--repeat 3]
 """
@@ -106,7 +108,8 @@ def main() -> None:
                         help='cProfile the passes, statistics as text to this file')
     args = parser.parse_args()
     rclpy.init(args=['--ros-args', '--params-file', str(default_config_path()),
-                     '-p', 'traction_rate_hz:=20.0'])   # as config/stack_sim_composed.yaml
+                     '-p', 'traction_rate_hz:=20.0',    # as config/stack_sim_composed.yaml
+                     '--log-level', 'error'])           # (stale-input warnings)
     try:
         runs = [one_pass(GOLDEN / args.bag, args.profile if k == 0 else None)
                 for k in range(args.repeat)]
