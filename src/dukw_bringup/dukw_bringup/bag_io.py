@@ -357,18 +357,41 @@ def read_messages(path: str | Path, topics: Iterable[str] | None = None
 
     Topic names match with or without the leading slash.
     """
-    reader = _open_reader(path)
-    try:
+    with BagReader(path) as bag:
+        yield from bag.messages(topics)
+
+
+class BagReader:
+    """An open bag read several times (e.g. a first pass, then a full one) for one open:
+    opening parses metadata.yaml and every topic's QoS YAML, which costs more than
+    thousands of messages. A context manager; ``messages`` as ``read_messages``."""
+
+    def __init__(self, path: str | Path) -> None:
+        self.reader = _open_reader(path)
+        self._open = True
+
+    def __enter__(self) -> 'BagReader':
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Close the bag (idempotent)."""
+        if self._open:
+            self._open = False
+            self.reader.close()
+
+    def messages(self, topics: Iterable[str] | None = None) -> Iterator[BagMessage]:
+        """The bag's messages in time order, optionally only of ``topics``."""
         wanted = None if topics is None else {topic_key(t) for t in topics}
-        conns = [c for c in reader.connections
+        conns = [c for c in self.reader.connections
                  if wanted is None or topic_key(c.topic) in wanted]
         if wanted is not None and not conns:
             return
-        for conn, timestamp, raw in reader.messages(connections=conns):
+        for conn, timestamp, raw in self.reader.messages(connections=conns):
             yield BagMessage(conn.topic, conn.msgtype, timestamp,
                              raw if type(raw) is bytes else bytes(raw))
-    finally:
-        reader.close()
 
 
 def deserialize(message: BagMessage, store: Typestore | None = None) -> Any:

@@ -121,10 +121,12 @@ def estimate_handoff(ekf: Node, mode_manager: Node | None, controller: Node | No
     manager (weight on the tracks), as their nodes take odometry/filtered and traction."""
     def on_estimate(estimate) -> None:
         now = now_s(ekf)
-        odom, traction = estimate.odometry, estimate.traction
-        if controller is not None:
+        odom = estimate.odometry
+        if controller is not None:          # the command out first, then the rest
             controller.publish(controller.runner.on_odometry(
                 odom.surge_mps, odom.yaw_rate_rps, odom.pitch_rad, now))
+        traction = estimate.traction        # (read from the estimator only now)
+        if controller is not None:
             controller.runner.on_traction(traction.port_slip, traction.stbd_slip, now)
         if mode_manager is not None:
             mode_manager.runner.on_traction(traction.weight_on_tracks_fraction, now)

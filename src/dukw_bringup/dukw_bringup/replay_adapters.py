@@ -8,6 +8,7 @@ recorded messages into named numbers to compare.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from operator import attrgetter
 from typing import Any, Callable
 
 from dukw_common.cmd_vel import read_cmd_vel
@@ -165,6 +166,9 @@ class EkfAdapter(CoreAdapter):
     angle_quantities = frozenset({'odom.yaw_rad'})
     #: traction fields compared (the message's float fields)
     TRACTION_FIELDS = ros_convert.TRACTION_FIELDS
+    #: their row names, and one call reading them all (a row per estimate: keep it cheap)
+    _TRACTION_KEYS = tuple(f'traction.{name}' for name in TRACTION_FIELDS)
+    _traction_values = staticmethod(attrgetter(*TRACTION_FIELDS))
 
     def __init__(self, config_path: str | None = None, runner: EkfRunner | None = None) -> None:
         self.runner = runner or EkfRunner.from_params(node_params('ekf_node', config_path))
@@ -187,8 +191,8 @@ class EkfAdapter(CoreAdapter):
         row = {'odom.x_m': float(odom.x_m), 'odom.y_m': float(odom.y_m),
                'odom.yaw_rad': float(odom.yaw_rad), 'odom.surge_mps': float(odom.surge_mps),
                'odom.yaw_rate_rps': float(odom.yaw_rate_rps)}
-        row.update({f'traction.{name}': float(getattr(traction, name))
-                    for name in cls.TRACTION_FIELDS})
+        row.update(zip(cls._TRACTION_KEYS, map(float, cls._traction_values(traction)),
+                       strict=True))
         return row
 
     @staticmethod
@@ -203,7 +207,8 @@ class EkfAdapter(CoreAdapter):
     def recorded(self, topic, msg):
         if topic == 'odometry/filtered':
             return self._odometry_row(msg)
-        return {f'traction.{name}': float(getattr(msg, name)) for name in self.TRACTION_FIELDS}
+        return dict(zip(self._TRACTION_KEYS, map(float, self._traction_values(msg)),
+                        strict=True))
 
 
 #: adapter name -> factory (config path -> adapter)

@@ -54,6 +54,7 @@ class EkfNode(Node):
         self.estimator = self.runner.estimator
         self.sources = SourceWatch()               # set_pose: one client, the operator's
         self.odom_pub = self.create_publisher(Odometry, 'odometry/filtered', COMMAND_QOS)
+        self._odom_msg = Odometry()                # filled anew for each estimate
         self.traction_pub = self.create_publisher(Traction, 'traction', COMMAND_QOS)
         self.diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', COMMAND_QOS)
         self.tf_pub = (self.create_publisher(TFMessage, '/tf', TF_QOS)
@@ -88,7 +89,7 @@ class EkfNode(Node):
         if estimate is None:
             return
         stamp = s_to_stamp(estimate.t_s)
-        odom = conv.odometry_msg(estimate.odometry, stamp, 'odom', 'base_link')
+        odom = conv.odometry_msg(estimate.odometry, stamp, 'odom', 'base_link', self._odom_msg)
         self.odom_pub.publish(odom)
         for listen in self.estimate_listeners:   # in-process consumers (commands) first
             listen(estimate)
@@ -108,6 +109,7 @@ class EkfNode(Node):
         if refusal:                                # one client (the operator's) or none
             response.success, response.message = False, refusal
             return response
+        self.runner.seal()                         # (a held estimate keeps its traction)
         response.success = self.estimator.set_pose(request.x_m, request.y_m, request.yaw_rad)
         response.message = 'pose set' if response.success else 'refused: non-finite pose'
         return response

@@ -109,9 +109,15 @@ SAMPLE_FROM_MSG = {'imu/data': imu_sample, 'gps/fix': gps_fix, 'gps/vel': gps_ve
                    'tracks/status': drive_status, 'props/status': drive_status}
 
 
-def odometry_msg(est: OdometryEstimate, stamp, frame_id: str, child_frame_id: str) -> Odometry:
-    """OdometryEstimate -> nav_msgs/Odometry (pose in odom, twist in base_link)."""
-    msg = Odometry()
+def odometry_msg(est: OdometryEstimate, stamp, frame_id: str, child_frame_id: str,
+                 out: Odometry | None = None) -> Odometry:
+    """OdometryEstimate -> nav_msgs/Odometry (pose in odom, twist in base_link).
+
+    ``out``: a message to fill instead of a new one (a publisher's own, reused for each
+    estimate: building an Odometry costs more than filling it). Every field this writes is
+    written each time; the others stay as ``Odometry()`` made them.
+    """
+    msg = Odometry() if out is None else out
     msg.header.stamp = stamp
     msg.header.frame_id = frame_id
     msg.child_frame_id = child_frame_id

@@ -17,8 +17,8 @@ nothing.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any, Mapping
+import weakref
+from typing import Any, Callable, Mapping
 
 from dukw_common.config import ParamValue
 from dukw_common.rates import Decimator
@@ -36,15 +36,40 @@ INPUTS = {'imu/data': 'add_imu', 'gps/fix': 'add_gps_fix', 'gps/vel': 'add_gps_v
           'tracks/status': 'add_tracks', 'props/status': 'add_props'}
 
 
-@dataclass(frozen=True)
 class Estimate:
     """What ekf_node publishes at once: odometry/filtered always; /tf and traction when
-    their observers' rates (``tf_rate_hz``, ``traction_rate_hz``) say so."""
+    their observers' rates (``tf_rate_hz``, ``traction_rate_hz``) say so.
 
-    odometry: OdometryEstimate
-    traction: TractionEstimate
-    tf_due: bool = True
-    traction_due: bool = True
+    The traction is read from the estimator when first asked for (``traction_query``): a
+    composed process hands the odometry to the controller and gets the command out before
+    it, and a traction nobody reads (not due, no listener) costs nothing. The runner that
+    made the estimate reads it before its estimator takes anything new while the estimate
+    is still held (EkfRunner.seal), so the value is the one of the estimate's instant.
+    """
+
+    __slots__ = ('odometry', 'tf_due', 'traction_due', '_traction', '_query', '__weakref__')
+
+    def __init__(self, odometry: OdometryEstimate, traction: TractionEstimate | None = None,
+                 tf_due: bool = True, traction_due: bool = True, *,
+                 traction_query: Callable[[], TractionEstimate] | None = None) -> None:
+        if (traction is None) == (traction_query is None):
+            raise ValueError('Estimate: give either the traction or the query for it')
+        self.odometry = odometry
+        self.tf_due = tf_due
+        self.traction_due = traction_due
+        self._traction = traction
+        self._query = traction_query
+
+    @property
+    def traction(self) -> TractionEstimate:
+        """The traction estimate at the estimate's instant."""
+        self.fix_traction()
+        return self._traction
+
+    def fix_traction(self) -> None:
+        """Read the traction now (before the estimator changes)."""
+        if self._traction is None:
+            self._traction, self._query = self._query(), None
 
     @property
     def t_s(self) -> float:
@@ -67,6 +92,7 @@ class EkfRunner:
         self._routes = {topic: getattr(estimator, name) for topic, name in INPUTS.items()}
         self._tf_due = Decimator(tf_rate_hz).due if tf_rate_hz else None
         self._traction_due = Decimator(traction_rate_hz).due if traction_rate_hz else None
+        self._last: weakref.ref[Estimate] | None = None     # the last estimate out
 
     @classmethod
     def from_params(cls, params: Mapping[str, ParamValue], vehicle: Vehicle | None = None,
@@ -84,6 +110,7 @@ class EkfRunner:
         add = self._routes.get(topic)
         if add is None:
             raise ValueError(f'ekf: no input {topic!r}; inputs are {sorted(INPUTS)}')
+        self.seal()
         add(sample)
         if topic != 'imu/data' or not self.publish_on_imu or self.estimator.t_s is None:
             return None
@@ -95,6 +122,7 @@ class EkfRunner:
         est = self.estimator
         if est.t_s is None or now_s - self.last_event_publish_s < SILENT_PERIODS * self.period_s:
             return None
+        self.seal()
         if 0.0 < now_s - est.t_s <= self.settings.sensor_timeout_s:
             est.advance(now_s)       # predict to the present, never further than a timeout
         return self._publication()
@@ -102,9 +130,20 @@ class EkfRunner:
     def _publication(self) -> Estimate:
         odometry = self.estimator.odometry()
         t_s = odometry.t_s
-        return Estimate(odometry, self.estimator.traction(),
-                        self._tf_due is None or self._tf_due(t_s),
-                        self._traction_due is None or self._traction_due(t_s))
+        estimate = Estimate(odometry, None,
+                            self._tf_due is None or self._tf_due(t_s),
+                            self._traction_due is None or self._traction_due(t_s),
+                            traction_query=self.estimator.traction)
+        self._last = weakref.ref(estimate)
+        return estimate
+
+    def seal(self) -> None:
+        """Read the last estimate's traction now if it is still held and unread: call
+        before changing the estimator other than through this runner (e.g. set_pose)."""
+        last, self._last = self._last, None
+        held = last() if last is not None else None
+        if held is not None:
+            held.fix_traction()
 
     def estimate(self) -> Estimate:
         """The current estimate (pure: asking changes nothing)."""

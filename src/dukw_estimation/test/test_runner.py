@@ -7,7 +7,7 @@ from dukw_common.config import node_params
 from dukw_common.readings import (DepthReading, DriveStatus, GpsFix, ImuSample, MotorSide,
                                   WaterContact, reading_topic)
 from dukw_estimation.ekf import Outcome
-from dukw_estimation.runner import EkfRunner
+from dukw_estimation.runner import EkfRunner, Estimate
 
 SIDE = MotorSide(50.0, 20.0, 1.0, 1632.0)
 
@@ -69,3 +69,37 @@ def test_asking_for_the_estimate_changes_nothing(runner):
         again = runner.estimate()
     assert again.odometry.x_m == first.odometry.x_m
     assert again.traction.weight_on_tracks_fraction == first.traction.weight_on_tracks_fraction
+
+
+def _drive_on(runner, held: list):
+    """IMU samples with the tracks pushing in between; keeps every estimate unread."""
+    for k in range(20):
+        t_s = 1.0 + 0.01 * k
+        status = DriveStatus(t_s, SIDE, SIDE, True, 'tracks')
+        runner.on_sample('tracks/status', status, t_s)
+        held.append(runner.on_sample('imu/data', _imu(t_s), t_s))
+
+
+def test_a_held_estimate_keeps_the_traction_of_its_instant(runner):
+    eager = EkfRunner.from_params(node_params('ekf_node'))
+    expected = []
+    for k in range(20):                   # the reference: traction read at once
+        t_s = 1.0 + 0.01 * k
+        eager.on_sample('tracks/status', DriveStatus(t_s, SIDE, SIDE, True, 'tracks'), t_s)
+        expected.append(eager.on_sample('imu/data', _imu(t_s), t_s).traction)
+    held = []
+    _drive_on(runner, held)               # read only after all the samples went in
+    got = [e.traction for e in held]
+    assert [t.effective_weight_n for t in got] == [t.effective_weight_n for t in expected]
+    assert [t.port_slip for t in got] == [t.port_slip for t in expected]
+    assert len({t.effective_weight_n for t in got}) > 1   # it did change over the run
+
+
+def test_an_estimate_needs_its_traction_or_the_query_for_it(runner):
+    runner.on_sample('imu/data', _imu(1.0), 1.0)
+    odometry = runner.estimator.odometry()
+    with pytest.raises(ValueError, match='either'):
+        Estimate(odometry)
+    with pytest.raises(ValueError, match='either'):
+        Estimate(odometry, runner.estimator.traction(),
+                 traction_query=runner.estimator.traction)
