@@ -262,10 +262,14 @@ def transition(direction: str, command: float, wave_height_m: float = 0.0,
 
 def drift(wave_height_m: float, duration_s: float = 60.0, wave_period_s: float | None = None,
           seed: int = 0, config: str | None = None) -> ManeuverRun:
-    """Afloat, bow to the beach in following seas, loosely held in place by a tether."""
+    """Afloat in the surf, bow to the beach in following seas, loosely held in place by a
+    tether. Where the paper drifted (vehicle.md 5, issue 13: in the surf of day 1): just
+    afloat over the slope, the 'sea' start (the treads start.sea_tread_clearance_m over the
+    sand, ~0.8 m of water), not the 'afloat' start off the slope in 1.5 m of water, where the
+    waves' particle velocities and their change along the hulls are smaller."""
     sim = SimCore.from_config(config, seed=seed,
                               overrides=_wave_overrides(wave_height_m, wave_period_s))
-    sim.reset('afloat', yaw_rad=math.pi)
+    sim.reset('sea', yaw_rad=math.pi)
     x0 = sim.x
     moor = sim.params.mooring
     anchor = (sim.x + math.cos(sim.yaw) * moor.attach_x_m,
@@ -352,7 +356,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument('--wave-period', type=_positive, default=None)
     p.add_argument('--slope-deg', type=_slope, default=None)
     p.add_argument('--duration', type=_positive, default=30.0)
-    p = sub.add_parser('drift', parents=[common], help='afloat, loosely held, following seas')
+    p = sub.add_parser('drift', parents=[common],
+                       help='afloat in the surf, loosely held, following seas')
     p.add_argument('--wave-height', type=_non_negative, required=True)
     p.add_argument('--wave-period', type=_positive, default=None)
     p.add_argument('--duration', type=_positive, default=60.0)
