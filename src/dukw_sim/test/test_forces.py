@@ -162,7 +162,7 @@ def test_mooring_pulls_back_to_the_anchor_and_turns_about_its_point():
     assert fy < 0.0 and moment > 0.0
 
 
-def _water(vx: np.ndarray, vy: np.ndarray) -> WaterSample:
+def _flow(vx: np.ndarray, vy: np.ndarray) -> WaterSample:
     return WaterSample(np.zeros(vx.size), vx, vy, np.zeros(vx.size), np.zeros(vx.size))
 
 
@@ -175,12 +175,12 @@ def test_water_yaw_rate_is_the_rotation_of_the_water_over_the_immersed_hull(yaw_
     ox, oy = c * xs - s * ys, s * xs + c * ys          # odom offsets from the centre
     areas = np.full(6, 0.05)
     spin, drift = 0.2, (0.3, -0.1)                     # rad/s and a uniform current, m/s
-    water = _water(drift[0] - spin * oy, drift[1] + spin * ox)
+    water = _flow(drift[0] - spin * oy, drift[1] + spin * ox)
     assert water_yaw_rate_rps(areas, water, xs, ys, (c, s)) == pytest.approx(spin, rel=1e-12)
     # a uniform flow does not turn the hull; strips out of the water do not count
-    assert water_yaw_rate_rps(areas, _water(np.full(6, 0.3), np.full(6, -0.1)), xs, ys,
+    assert water_yaw_rate_rps(areas, _flow(np.full(6, 0.3), np.full(6, -0.1)), xs, ys,
                               (c, s)) == pytest.approx(0.0, abs=1e-12)
-    shear = _water(np.zeros(6), np.array([0.0, 0.0, 0.5, 0.0, 0.0, 0.0]))
+    shear = _flow(np.zeros(6), np.array([0.0, 0.0, 0.5, 0.0, 0.0, 0.0]))
     bow_dry = areas.copy()
     bow_dry[2] = 0.0
     assert water_yaw_rate_rps(areas, shear, xs, ys, (1.0, 0.0)) > 0.0
