@@ -286,6 +286,8 @@ def drift(wave_height_m: float, duration_s: float = 60.0, wave_period_s: float |
         'rms_heave_m': _rms(run.array(lambda t: t.z_m, settle)),
         'rms_roll_deg': math.degrees(_rms(run.array(lambda t: t.roll_rad, settle))),
         'rms_pitch_deg': math.degrees(_rms(run.array(lambda t: t.pitch_rad, settle))),
+        'rms_yaw_deg': math.degrees(_rms(np.unwrap(run.array(lambda t: t.yaw_rad, settle)))),
+        'rms_yaw_rate_dps': math.degrees(_rms(run.array(lambda t: t.yaw_rate_rps, settle))),
         'rms_surge_mps': _rms(run.array(lambda t: t.surge_mps, settle)),
         'mean_shoreward_offset_m': -_mean(run.array(lambda t: t.x_m, settle) - x0),
         'rms_wave_force_n': _rms(run.array(lambda t: t.wave_surge_force_n, settle)),
