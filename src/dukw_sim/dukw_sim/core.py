@@ -33,7 +33,8 @@ from dukw_sim.forces import (LATERAL_POINTS, BodyForces, Immersion, WaveForcing,
                              drivetrain_friction_n, hydrodynamic_drag, immersion,
                              lateral_resistance, odom_force, paddle_wrench, propulsion,
                              rolling_resistance, slope_gravity, sum_wrenches, surf_resistance,
-                             track_paddle_n, track_wetness, wave_forcing, wave_moments)
+                             track_paddle_n, track_wetness, water_yaw_rate_rps, wave_forcing,
+                             wave_moments)
 from dukw_sim.hull import HullGeometry, Seakeeping
 from dukw_sim.land import TrackContact, TrackLinear, linearise, motor_limited_speed
 from dukw_sim.params import SimParams, apply_overrides
@@ -321,11 +322,12 @@ class SimCore:
         uw = c * waves.water_u_mps + s * waves.water_v_mps
         vw = -s * waves.water_u_mps + c * waves.water_v_mps
         u_rel, v_rel = u0 - uw, v0 - vw
+        r_rel = self.r - self._water_yaw_rate(areas, water, (c, s))
         drives = self._track_drives(act, u_rel, w_eff, depths)
         thrust = self._thrust_n(act, water.elevation_m)
         moments = self._wave_moments(areas, water, (c, s))
-        forces = self._body_forces(drives, imm, waves, thrust, w_eff, (u_rel, v_rel), (c, s),
-                                   moments.yaw_nm)
+        forces = self._body_forces(drives, imm, waves, thrust, w_eff, (u_rel, v_rel, r_rel),
+                                   (c, s), moments.yaw_nm)
         tracks = self._integrate_plane(forces, drives, imm.fraction, (c, s))
         if self.in_contact:
             self._follow_ground()
@@ -411,6 +413,14 @@ class SimCore:
                             self.hull.station_x_m, self.hull.station_y_m, yaw_cs,
                             self._wave_lever_z)
 
+    def _water_yaw_rate(self, areas: np.ndarray, water, yaw_cs: tuple) -> float:
+        """The water's yaw rate over the hull that the yaw damping acts against (a strip-wise
+        wave moment too: waves.moments.strip_moments), else 0, rad/s."""
+        if not self.params.wave_moments.strip_moments or self.world.calm:
+            return 0.0
+        return water_yaw_rate_rps(areas, water, self.hull.station_x_m, self.hull.station_y_m,
+                                  yaw_cs)
+
     def _track_wetness(self) -> float:
         """Share of the tracks' height under the surface (over the contact length), 0..1."""
         px, water = self._hydro()[:2]
@@ -435,7 +445,7 @@ class SimCore:
                 terms += surf_resistance(w_eff, self._track_wetness(), drives.ground,
                                          self.params.surf, half)
         terms += propulsion(thrust, wat.prop_walk_ratio, self.params.propeller.x_m, half)
-        terms.append(hydrodynamic_drag(rel_water[0], rel_water[1], self.r, imm.fraction, wat))
+        terms.append(hydrodynamic_drag(*rel_water, imm.fraction, wat))
         ex, ey, en = self._external
         terms.append(odom_force(waves.fx_n + ex, waves.fy_n + ey,
                                 en + wave_yaw_nm if wave_yaw_nm else en, c, s))

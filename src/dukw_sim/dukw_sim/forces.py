@@ -118,6 +118,25 @@ def wave_forcing(calm: bool, areas_m2: np.ndarray, strip_length_m: float, water:
     return WaveForcing(fwx, fwy, wu, wv)
 
 
+def water_yaw_rate_rps(areas_m2: np.ndarray, water: WaterSample, station_x_m: np.ndarray,
+                       station_y_m: np.ndarray, yaw_cs: tuple) -> float:
+    """The water's own yaw rate over the hull: the least-squares rotation of the wave particle
+    velocity at the immersed strips (body axes, immersed area as weight), rad/s.
+
+    The hull drag acts on the velocity relative to the water, strip by strip; in a
+    short-crested sea the transverse water velocity differs along the hulls (and the surge
+    velocity between them), so the yaw damping acts on r minus this rate, as the surge and sway
+    drag act on u and v minus the water's mean velocity (``wave_forcing``)."""
+    c, s = yaw_cs
+    n = station_x_m.size
+    ub = c * water.velocity_x_mps[:n] + s * water.velocity_y_mps[:n]
+    vb = -s * water.velocity_x_mps[:n] + c * water.velocity_y_mps[:n]
+    weight = float(areas_m2 @ (station_x_m ** 2 + station_y_m ** 2))
+    if weight <= 1e-12:
+        return 0.0
+    return float(areas_m2 @ (station_x_m * vb - station_y_m * ub)) / weight
+
+
 class WaveMoments(NamedTuple):
     """Moments about the centre of gravity of the strips' wave forces: yaw (odom z), roll and
     pitch (body x, y), N m."""

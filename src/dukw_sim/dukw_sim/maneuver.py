@@ -262,10 +262,14 @@ def transition(direction: str, command: float, wave_height_m: float = 0.0,
 
 def drift(wave_height_m: float, duration_s: float = 60.0, wave_period_s: float | None = None,
           seed: int = 0, config: str | None = None) -> ManeuverRun:
-    """Afloat, bow to the beach in following seas, loosely held in place by a tether."""
+    """Afloat in the surf, bow to the beach in following seas, loosely held in place by a
+    tether. Where the paper drifted (vehicle.md 5, issue 13: in the surf of day 1): just
+    afloat over the slope, the 'sea' start (the treads start.sea_tread_clearance_m over the
+    sand, ~0.8 m of water), not the 'afloat' start off the slope in 1.5 m of water, where the
+    waves' particle velocities and their change along the hulls are smaller."""
     sim = SimCore.from_config(config, seed=seed,
                               overrides=_wave_overrides(wave_height_m, wave_period_s))
-    sim.reset('afloat', yaw_rad=math.pi)
+    sim.reset('sea', yaw_rad=math.pi)
     x0 = sim.x
     moor = sim.params.mooring
     anchor = (sim.x + math.cos(sim.yaw) * moor.attach_x_m,
@@ -282,6 +286,8 @@ def drift(wave_height_m: float, duration_s: float = 60.0, wave_period_s: float |
         'rms_heave_m': _rms(run.array(lambda t: t.z_m, settle)),
         'rms_roll_deg': math.degrees(_rms(run.array(lambda t: t.roll_rad, settle))),
         'rms_pitch_deg': math.degrees(_rms(run.array(lambda t: t.pitch_rad, settle))),
+        'rms_yaw_deg': math.degrees(_rms(np.unwrap(run.array(lambda t: t.yaw_rad, settle)))),
+        'rms_yaw_rate_dps': math.degrees(_rms(run.array(lambda t: t.yaw_rate_rps, settle))),
         'rms_surge_mps': _rms(run.array(lambda t: t.surge_mps, settle)),
         'mean_shoreward_offset_m': -_mean(run.array(lambda t: t.x_m, settle) - x0),
         'rms_wave_force_n': _rms(run.array(lambda t: t.wave_surge_force_n, settle)),
@@ -352,7 +358,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument('--wave-period', type=_positive, default=None)
     p.add_argument('--slope-deg', type=_slope, default=None)
     p.add_argument('--duration', type=_positive, default=30.0)
-    p = sub.add_parser('drift', parents=[common], help='afloat, loosely held, following seas')
+    p = sub.add_parser('drift', parents=[common],
+                       help='afloat in the surf, loosely held, following seas')
     p.add_argument('--wave-height', type=_non_negative, required=True)
     p.add_argument('--wave-period', type=_positive, default=None)
     p.add_argument('--duration', type=_positive, default=60.0)

@@ -316,6 +316,23 @@ def test_a_short_crested_sea_yaws_a_drifting_vehicle_through_the_strip_moments()
     assert _drift_yaw_rate_rms_dps(strip_moments=True) > 0.3
 
 
+def _heavily_damped_drift_yaw_rate_rms_dps(strip_moments: bool) -> float:
+    sim = SimCore.from_config(overrides={'waves.model': 'irregular',
+                                         'waves.moments.strip_moments': strip_moments,
+                                         'water.yaw_linear_drag_nm_per_rps': 2e4}, seed=3)
+    sim.reset('sea', yaw_rad=math.pi)
+    rates = [sim.step(Actuation()).yaw_rate_rps for _ in range(2000)]
+    return math.degrees(float(np.sqrt(np.mean(np.square(rates[500:])))))
+
+
+def test_the_yaw_damping_acts_against_the_waters_rotation_not_the_seabed():
+    # issue 13 (drift): the hull drag acts on the velocity relative to the water, so however
+    # strong the yaw damping, a drifting hull turns with the short-crested sea's rotation
+    # (~2 deg/s in the surf) instead of being held still (wave moment / damping ~ 0.1 deg/s)
+    assert _heavily_damped_drift_yaw_rate_rms_dps(strip_moments=True) > 1.0
+    assert _heavily_damped_drift_yaw_rate_rms_dps(strip_moments=False) < 1e-6
+
+
 def _soil_force_n(coeff: float, x_m: float) -> float:
     sim = SimCore.from_config(overrides={'surf.wet_motion_resistance_coeff': coeff})
     sim.reset(x_m=x_m)

@@ -9,7 +9,8 @@ import pytest
 from dukw_sim.core import SimCore
 from dukw_sim.forces import (Wrench, hydrodynamic_drag, lateral_resistance, mooring,
                              odom_force, propulsion, rolling_resistance, slope_gravity,
-                             sum_wrenches, surf_resistance, track_wetness, wave_moments)
+                             sum_wrenches, surf_resistance, track_wetness, water_yaw_rate_rps,
+                             wave_moments)
 from dukw_sim.world import WaterSample
 
 PARAMS = SimCore.from_config().params
@@ -159,3 +160,29 @@ def test_mooring_pulls_back_to_the_anchor_and_turns_about_its_point():
     # starboard, a + yaw moment that turns the vehicle back (held at the stern: stable)
     _, fy, moment = mooring(moor, 0.0, 0.0, -0.1, 0.0, 0.0, 0.0, anchor)
     assert fy < 0.0 and moment > 0.0
+
+
+def _flow(vx: np.ndarray, vy: np.ndarray) -> WaterSample:
+    return WaterSample(np.zeros(vx.size), vx, vy, np.zeros(vx.size), np.zeros(vx.size))
+
+
+@pytest.mark.parametrize('yaw_rad', [0.0, 2.5])
+def test_water_yaw_rate_is_the_rotation_of_the_water_over_the_immersed_hull(yaw_rad):
+    """Issue 13 (drift): the yaw damping acts on r less the water's rotation over the hulls."""
+    xs = np.array([-1.0, 0.0, 1.0, -1.0, 0.0, 1.0])
+    ys = np.array([0.4, 0.4, 0.4, -0.4, -0.4, -0.4])
+    c, s = math.cos(yaw_rad), math.sin(yaw_rad)
+    ox, oy = c * xs - s * ys, s * xs + c * ys          # odom offsets from the centre
+    areas = np.full(6, 0.05)
+    spin, drift = 0.2, (0.3, -0.1)                     # rad/s and a uniform current, m/s
+    water = _flow(drift[0] - spin * oy, drift[1] + spin * ox)
+    assert water_yaw_rate_rps(areas, water, xs, ys, (c, s)) == pytest.approx(spin, rel=1e-12)
+    # a uniform flow does not turn the hull; strips out of the water do not count
+    assert water_yaw_rate_rps(areas, _flow(np.full(6, 0.3), np.full(6, -0.1)), xs, ys,
+                              (c, s)) == pytest.approx(0.0, abs=1e-12)
+    shear = _flow(np.zeros(6), np.array([0.0, 0.0, 0.5, 0.0, 0.0, 0.0]))
+    bow_dry = areas.copy()
+    bow_dry[2] = 0.0
+    assert water_yaw_rate_rps(areas, shear, xs, ys, (1.0, 0.0)) > 0.0
+    assert water_yaw_rate_rps(bow_dry, shear, xs, ys, (1.0, 0.0)) == 0.0
+    assert water_yaw_rate_rps(np.zeros(6), water, xs, ys, (c, s)) == 0.0

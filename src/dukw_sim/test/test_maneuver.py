@@ -1,12 +1,14 @@
 """The maneuver tool: every sub-command, its CSV and JSON, bad arguments."""
 import csv
 import json
+import math
 import subprocess
 import sys
 
 import pytest
 
 from dukw_sim import maneuver
+from dukw_sim.core import SimCore
 
 REQUIRED = ('t,x,y,yaw,u,v,r,z,roll,pitch,heave_vel,port_cmd,stbd_cmd,port_current_a,'
             'stbd_current_a,port_force_n,stbd_force_n,port_slip,stbd_slip,submerged_volume_m3,'
@@ -28,7 +30,7 @@ CASES = [
     (['transition', '--direction', 'sea-to-land', '--command', '100', '--slope-deg', '6',
       '--duration', '3'], ['end_medium', 'max_submerged_volume_m3'], 3.0),
     (['drift', '--wave-height', '0.08', '--duration', '4'],
-     ['rms_heave_m', 'rms_roll_deg', 'rms_pitch_deg'], 4.0),
+     ['rms_heave_m', 'rms_roll_deg', 'rms_pitch_deg', 'rms_yaw_rate_dps'], 4.0),
 ]
 
 
@@ -113,3 +115,15 @@ def test_circle_fit_recovers_a_circle():
     assert (cx, cy, r) == pytest.approx((3, -1, 2))
     with pytest.raises(ValueError):
         maneuver.fit_circle(np.zeros(2), np.zeros(2))
+
+
+def test_drift_floats_in_the_surf_bow_to_the_beach():
+    """Issue 13: the paper drifted in the surf, not off the slope: the 'sea' start (afloat
+    over the slope, the treads start.sea_tread_clearance_m over the sand)."""
+    run = maneuver.drift(0.28, 1.0, seed=3)
+    start = run.rows[0]
+    sim = SimCore.from_config()
+    assert start.x_m == pytest.approx(sim.start_x_m('sea'))
+    assert start.x_m < sim.world.beach.sea_floor_x_m            # over the slope
+    assert abs(abs(start.yaw_rad) - math.pi) < 1e-9             # bow to the beach
+    assert not any(t.in_ground_contact for t in run.rows[:10])  # afloat
