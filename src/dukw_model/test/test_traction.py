@@ -116,3 +116,47 @@ def test_the_scalar_path_gives_the_array_path_bit_for_bit():
             one = tr.tractive_force_n(slip_, w, soil, 0.5, 1.2)
             many = tr.tractive_force_n(np.array([slip_]), np.array([w]), soil, 0.5, 1.2)[0]
             assert one == many and math.copysign(1.0, one) == math.copysign(1.0, many)
+
+
+# ------------------------------------------------ pore suction of saturated sand (issue 13)
+SUCTION = traction.PoreSuction(pa_per_mps=20000.0, max_pa=100000.0)
+
+
+def test_pore_suction_grows_with_slip_velocity_and_saturation_up_to_cavitation():
+    assert traction.pore_suction_pa(0.0, 1.0, SUCTION) == 0.0            # no shearing
+    assert traction.pore_suction_pa(1.0, 0.0, SUCTION) == 0.0            # dry sand
+    assert traction.pore_suction_pa(-0.5, 1.0, SUCTION) == pytest.approx(10000.0)
+    assert traction.pore_suction_pa(0.5, 0.5, SUCTION) == pytest.approx(5000.0)
+    assert traction.pore_suction_pa(50.0, 1.0, SUCTION) == pytest.approx(100000.0)
+    arr = traction.pore_suction_pa(np.array([0.0, 1.0, 9.0]), 1.0, SUCTION)
+    assert arr == pytest.approx([0.0, 20000.0, 100000.0])
+    with pytest.raises(ValueError):
+        traction.PoreSuction(-1.0, 0.0)
+
+
+def test_dry_or_unsheared_sand_gives_the_plain_wong_force():
+    for v_t, v_r in ((1.2, 0.8), (0.5, 0.5), (-1.0, -0.4)):
+        plain = traction.track_force_n(v_t, v_r, 1000.0, SOIL, A / 2, L)
+        dry = traction.track_force_n(v_t, v_r, 1000.0, SOIL, A / 2, L, SUCTION, 0.0)
+        assert dry == plain
+    afloat = traction.track_force_n(1.2, 0.2, 0.0, SOIL, A / 2, L, SUCTION, 1.0)
+    assert afloat == 0.0                                   # off the ground: no patch at all
+
+
+def test_saturated_sand_strengthens_with_slip_velocity_within_the_cavitation_bound():
+    speeds = (0.4, 0.8, 1.2, 2.0)
+    forces = [traction.track_force_n(v_t, 0.2, 1000.0, SOIL, A / 2, L, SUCTION, 1.0)
+              for v_t in speeds]
+    plain = [traction.track_force_n(v_t, 0.2, 1000.0, SOIL, A / 2, L) for v_t in speeds]
+    assert all(f > p for f, p in zip(forces, plain, strict=True))
+    assert forces == sorted(forces)
+    # at slip velocity 1.0 m/s: 20 kPa over the patch adds A/2 x 20 kPa x tan(phi)
+    gain = forces[2] / plain[2]
+    expected = (A / 2 * SOIL.cohesion_pa + (1000.0 + A / 2 * 20000.0)
+                * math.tan(SOIL.friction_angle_rad)) / (
+        A / 2 * SOIL.cohesion_pa + 1000.0 * math.tan(SOIL.friction_angle_rad))
+    assert gain == pytest.approx(expected, rel=1e-9)
+    bound = traction.max_traction_n(1000.0, SOIL, A / 2, SUCTION.max_pa)
+    assert traction.track_force_n(50.0, 0.0, 1000.0, SOIL, A / 2, L, SUCTION, 1.0) <= bound
+    braking = traction.track_force_n(0.2, 1.2, 1000.0, SOIL, A / 2, L, SUCTION, 1.0)
+    assert braking < traction.track_force_n(0.2, 1.2, 1000.0, SOIL, A / 2, L) < 0.0

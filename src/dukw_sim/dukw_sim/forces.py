@@ -159,6 +159,14 @@ def track_wetness(water_over_ground_m: np.ndarray, track_height_m: float) -> flo
     return float(np.mean(np.clip(water_over_ground_m / track_height_m, 0.0, 1.0)))
 
 
+def saturated_share(water_over_ground_m: np.ndarray) -> float:
+    """Share of the given points along the tracks with water standing over the sand: there
+    the sand under the tracks is saturated, 0 (dry beach) .. 1 (all under the surf)."""
+    if water_over_ground_m.size == 0:
+        return 0.0
+    return float(np.count_nonzero(water_over_ground_m > 0.0)) / water_over_ground_m.size
+
+
 def surf_resistance(w_eff_n: float, wetness: float, ground_mps: tuple, surf: SurfParams,
                     half_sep_m: float) -> list[Wrench]:
     """Motion resistance of the wet, partly liquefied sand under the surf (sinkage and

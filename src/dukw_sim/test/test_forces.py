@@ -9,7 +9,8 @@ import pytest
 from dukw_sim.core import SimCore
 from dukw_sim.forces import (Wrench, hydrodynamic_drag, lateral_resistance, mooring,
                              odom_force, propulsion, rolling_resistance, slope_gravity,
-                             sum_wrenches, surf_resistance, track_wetness, wave_moments)
+                             saturated_share, sum_wrenches, surf_resistance, track_wetness,
+                             wave_moments)
 from dukw_sim.world import WaterSample
 
 PARAMS = SimCore.from_config().params
@@ -133,6 +134,12 @@ def test_track_wetness_is_the_covered_share_of_the_tracks():
     assert track_wetness(np.array([-0.2, 0.0]), 0.25) == 0.0
     assert track_wetness(np.array([0.125, 0.5]), 0.25) == pytest.approx(0.75)
     assert track_wetness(np.zeros(0), 0.25) == 0.0
+
+
+def test_saturated_share_counts_the_points_under_water():
+    assert saturated_share(np.array([-0.2, 0.0, -0.01])) == 0.0
+    assert saturated_share(np.array([0.01, -0.1, 0.3, -0.2])) == pytest.approx(0.5)
+    assert saturated_share(np.zeros(0)) == 0.0
 
 
 def test_surf_resistance_grows_with_wetness_and_weight_within_the_tow_test_bound():
