@@ -487,3 +487,18 @@ def test_asking_for_the_estimate_changes_nothing():
         for odometry_again, traction_again in seen_often[5 * k:5 * k + 5]:
             _same(odometry_again, odometry)
             _same(traction_again, traction_)
+
+
+def test_the_surface_observer_uses_the_saturated_sands_strength_where_water_covers_the_sand():
+    # issue 13: the simulator's saturated sand carries more force with the slip velocity (pore
+    # suction, the shared saturated_sand.*); the estimator's force model is the same, so the
+    # track forces in the surf do not read as less water. Dry sand: the plain Wong force.
+    contact = make().contact
+    assert VEHICLE.saturated_sand.pore_suction_pa_per_mps > 0.0
+    assert contact.saturation(-3.0, 0.0, 1.0) == 0.0           # above the waterline
+    assert contact.saturation(3.0, 0.0, 1.0) == 1.0            # the patch under water
+    assert 0.0 < contact.saturation(0.0, 0.0, 1.0) < 1.0       # across the waterline
+    plain = float(traction.track_force_n(1.2, 0.4, 1000.0, contact.soil, contact.track_area_m2,
+                                         VEHICLE.body.track_contact_length_m))
+    assert contact.track_force_n(1.2, 0.4, 1000.0, 0.0) == plain
+    assert contact.track_force_n(1.2, 0.4, 1000.0, 1.0) > plain

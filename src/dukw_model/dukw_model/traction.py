@@ -9,54 +9,39 @@ every function takes floats or numpy arrays.
 
 In saturated sand (under the surf) shearing fast dilates the sand faster than the pore water
 can flow in: the pore pressure drops and the effective normal stress on the shear surface
-rises by that suction (dilatancy hardening). ``PoreSuction`` adds it to the strength,
+rises by that suction (dilatancy hardening). ``SaturatedSandParams`` (config
+``saturated_sand.*``) adds it to the strength,
 A c + (W_e + A s) tan phi, with s growing with the slip velocity |v_t - v_r| up to the
 cavitation limit (``pore_suction_pa``); on dry sand and with no slip it is zero.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from dukw_model.scalars import is_scalar
 
-from dukw_common.vehicle import SoilParams
+from dukw_common.vehicle import SaturatedSandParams, SoilParams
 
 ArrayLike = float | np.ndarray
 
 
-@dataclass(frozen=True)
-class PoreSuction:
-    """Dilatancy hardening of saturated sand sheared by the tracks.
-
-    The pore water under-pressure grows linearly with the shear (slip) velocity, as in
-    the cutting of saturated sand (van Os 1977; Miedema, The Delft Sand, Clay and Rock
-    Cutting Model, 2014: dilatancy-limited cutting forces proportional to the cutting
-    velocity), and cannot exceed the cavitation limit rho_w g (10 m + depth), about
-    100 kPa. ``saturation`` (0 dry .. 1 saturated) scales it where it applies.
-    """
-
-    pa_per_mps: float          # suction per m/s of slip velocity in saturated sand
-    max_pa: float              # cavitation limit
-
-    def __post_init__(self) -> None:
-        if not (self.pa_per_mps >= 0.0 and self.max_pa >= 0.0):
-            raise ValueError('PoreSuction pa_per_mps and max_pa must be >= 0')
-
-
-NO_SUCTION = PoreSuction(0.0, 0.0)
+#: No dilatancy hardening: the plain (dry-sand) Wong force. The saturated sand's (van Os 1977;
+#: Miedema, The Delft Sand, Clay and Rock Cutting Model, 2014: dilatancy-limited cutting forces
+#: of saturated sand proportional to the velocity, up to cavitation at rho_w g (10 m + depth))
+#: is the shared config's ``saturated_sand.*`` (Vehicle.saturated_sand).
+NO_SUCTION = SaturatedSandParams(0.0, 0.0)
 
 
 def pore_suction_pa(slip_speed_mps: ArrayLike, saturation: float,
-                    suction: PoreSuction) -> ArrayLike:
-    """Pore under-pressure s = saturation x min(pa_per_mps |v_slip|, max_pa), Pa (>= 0)."""
+                    suction: SaturatedSandParams) -> ArrayLike:
+    """Pore under-pressure s = saturation x min(rate |v_slip|, cavitation limit), Pa (>= 0)."""
     sat = min(max(float(saturation), 0.0), 1.0)
+    rate, limit = suction.pore_suction_pa_per_mps, suction.max_pore_suction_pa
     if is_scalar(slip_speed_mps):
-        return sat * min(suction.pa_per_mps * abs(float(slip_speed_mps)), suction.max_pa)
-    out = sat * np.minimum(suction.pa_per_mps * np.abs(np.asarray(slip_speed_mps, dtype=float)),
-                           suction.max_pa)
+        return sat * min(rate * abs(float(slip_speed_mps)), limit)
+    out = sat * np.minimum(rate * np.abs(np.asarray(slip_speed_mps, dtype=float)), limit)
     return float(out) if out.ndim == 0 else out
 
 
@@ -78,6 +63,19 @@ def slip(track_speed_mps: ArrayLike, ground_speed_mps: ArrayLike,
     denom = sign * np.maximum(np.abs(v_t), min_track_speed_mps)
     i = np.clip((v_t - v_r) / denom, -1.0, 1.0)
     return float(i) if i.ndim == 0 else i
+
+
+def saturated_share(depth_at_centre_m: float, depth_per_m: float, length_m: float) -> float:
+    """Share of a track patch of ``length_m`` with water over the sand, 0..1, where the water
+    depth over the sand is ``depth_at_centre_m`` at the patch's centre and changes by
+    ``depth_per_m`` along it (a plane surface over a plane beach): there the sand under the
+    track is saturated."""
+    half = 0.5 * length_m
+    if abs(depth_per_m) * half < 1e-9:
+        return 1.0 if depth_at_centre_m > 0.0 else 0.0
+    zero_m = -depth_at_centre_m / depth_per_m          # where the depth crosses zero
+    wet_m = half - zero_m if depth_per_m > 0.0 else zero_m + half
+    return min(max(wet_m / length_m, 0.0), 1.0)
 
 
 def shear_development(slip_abs: ArrayLike, contact_length_m: float,
@@ -141,7 +139,7 @@ def tractive_force_n(slip_: ArrayLike, effective_weight_n: ArrayLike, soil: Soil
 
 def track_force_n(track_speed_mps: ArrayLike, ground_speed_mps: ArrayLike,
                   effective_weight_n: ArrayLike, soil: SoilParams, contact_area_m2: float,
-                  contact_length_m: float, suction: PoreSuction = NO_SUCTION,
+                  contact_length_m: float, suction: SaturatedSandParams = NO_SUCTION,
                   saturation: float = 0.0) -> ArrayLike:
     """Soil force on the vehicle from a track at ``track_speed_mps`` over the ground at
     ``ground_speed_mps``, N (+ forward).
@@ -154,7 +152,7 @@ def track_force_n(track_speed_mps: ArrayLike, ground_speed_mps: ArrayLike,
     """
     v_t = np.asarray(track_speed_mps, dtype=float)
     suction_pa = 0.0
-    if saturation > 0.0 and suction.pa_per_mps > 0.0:
+    if saturation > 0.0 and suction.pore_suction_pa_per_mps > 0.0:
         suction_pa = pore_suction_pa(v_t - np.asarray(ground_speed_mps, dtype=float),
                                      saturation, suction)
     h = tractive_force_n(slip(v_t, ground_speed_mps), effective_weight_n, soil,

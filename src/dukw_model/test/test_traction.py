@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from dukw_common.vehicle import SoilParams
+from dukw_common.vehicle import SaturatedSandParams, SoilParams
 from dukw_model import traction
 
 SOIL = SoilParams(cohesion_pa=150.0, friction_angle_rad=math.radians(9.93), shear_modulus_m=0.053)
@@ -119,7 +119,7 @@ def test_the_scalar_path_gives_the_array_path_bit_for_bit():
 
 
 # ------------------------------------------------ pore suction of saturated sand (issue 13)
-SUCTION = traction.PoreSuction(pa_per_mps=20000.0, max_pa=100000.0)
+SUCTION = SaturatedSandParams(pore_suction_pa_per_mps=20000.0, max_pore_suction_pa=100000.0)
 
 
 def test_pore_suction_grows_with_slip_velocity_and_saturation_up_to_cavitation():
@@ -131,7 +131,7 @@ def test_pore_suction_grows_with_slip_velocity_and_saturation_up_to_cavitation()
     arr = traction.pore_suction_pa(np.array([0.0, 1.0, 9.0]), 1.0, SUCTION)
     assert arr == pytest.approx([0.0, 20000.0, 100000.0])
     with pytest.raises(ValueError):
-        traction.PoreSuction(-1.0, 0.0)
+        SaturatedSandParams(-1.0, 0.0)
 
 
 def test_dry_or_unsheared_sand_gives_the_plain_wong_force():
@@ -156,7 +156,18 @@ def test_saturated_sand_strengthens_with_slip_velocity_within_the_cavitation_bou
                 * math.tan(SOIL.friction_angle_rad)) / (
         A / 2 * SOIL.cohesion_pa + 1000.0 * math.tan(SOIL.friction_angle_rad))
     assert gain == pytest.approx(expected, rel=1e-9)
-    bound = traction.max_traction_n(1000.0, SOIL, A / 2, SUCTION.max_pa)
+    bound = traction.max_traction_n(1000.0, SOIL, A / 2, SUCTION.max_pore_suction_pa)
     assert traction.track_force_n(50.0, 0.0, 1000.0, SOIL, A / 2, L, SUCTION, 1.0) <= bound
     braking = traction.track_force_n(0.2, 1.2, 1000.0, SOIL, A / 2, L, SUCTION, 1.0)
     assert braking < traction.track_force_n(0.2, 1.2, 1000.0, SOIL, A / 2, L) < 0.0
+
+
+def test_saturated_share_of_a_patch_on_a_plane_beach():
+    # depth over the sand d0 + g x along a 1 m patch: wet where it is > 0
+    assert traction.saturated_share(0.0, 0.1, 1.0) == pytest.approx(0.5)
+    assert traction.saturated_share(0.0, -0.1, 1.0) == pytest.approx(0.5)
+    assert traction.saturated_share(0.025, 0.1, 1.0) == pytest.approx(0.75)
+    assert traction.saturated_share(-1.0, 0.1, 1.0) == 0.0
+    assert traction.saturated_share(1.0, 0.1, 1.0) == 1.0
+    assert traction.saturated_share(0.01, 0.0, 1.0) == 1.0         # level water over the patch
+    assert traction.saturated_share(-0.01, 0.0, 1.0) == 0.0

@@ -159,8 +159,7 @@ class SimCore:
         self._wet_soil = _soil_with_floor(vehicle.soil, land.min_shear_modulus_m)
         dry = params.dry_soil or vehicle.soil
         self._dry_soil = _soil_with_floor(dry, land.min_shear_modulus_m)
-        self._suction = traction.PoreSuction(params.surf.pore_suction_pa_per_mps,
-                                             params.surf.max_pore_suction_pa)
+        self._suction = vehicle.saturated_sand
         s = vehicle.sensors
         n = self.hull.station_x_m.size
         self._n_stations = n
@@ -404,7 +403,7 @@ class SimCore:
         if self.x < self.params.world.wet_sand_start_x_m:
             return TrackContact(w_eff / 2.0, self._dry_soil, self._track_area, self._track_len)
         saturation = 0.0
-        if self._suction.pa_per_mps > 0.0:
+        if self._suction.pore_suction_pa_per_mps > 0.0:
             saturation = saturated_share(self._water_over_tracks())
         return TrackContact(w_eff / 2.0, self._wet_soil, self._track_area, self._track_len,
                             self._suction, saturation)

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from dukw_common.vehicle import SoilParams
+from dukw_common.vehicle import SaturatedSandParams, SoilParams
 from dukw_model import traction
 
 _GRID = np.linspace(0.0, 1.0, 41)
@@ -36,7 +36,7 @@ class TrackContact:
     soil: SoilParams
     area_m2: float           # one track's patch, b l
     length_m: float
-    suction: traction.PoreSuction = traction.NO_SUCTION   # saturated sand's dilatancy
+    suction: SaturatedSandParams = traction.NO_SUCTION   # saturated sand's dilatancy
     saturation: float = 0.0  # 0 dry sand .. 1 saturated (the tracks' wetted share)
 
     def forces_n(self, track_mps: np.ndarray, ground_mps: np.ndarray) -> np.ndarray:
@@ -48,7 +48,7 @@ class TrackContact:
     def strength_n(self, slipping: bool = False) -> float:
         """The patch's shear strength, N: without pore suction (no slip velocity), or with
         the most suction the saturated sand can hold (``slipping``: a bound at any slip)."""
-        suction_pa = self.saturation * self.suction.max_pa if slipping else 0.0
+        suction_pa = self.saturation * self.suction.max_pore_suction_pa if slipping else 0.0
         return float(traction.max_traction_n(self.weight_per_track_n, self.soil, self.area_m2,
                                              suction_pa))
 

@@ -151,15 +151,11 @@ class SurfParams:
 
     wet_motion_resistance_coeff: float   # x W_e x the tracks' wetted share
     max_resistance_n: float              # the tow tests' largest resistance (bound)
-    pore_suction_pa_per_mps: float       # saturated sand's dilatancy: suction per m/s of slip
-    max_pore_suction_pa: float           # its cavitation limit
 
     def __post_init__(self) -> None:
         _positive(self, 'max_resistance_n')
-        for name in ('wet_motion_resistance_coeff', 'pore_suction_pa_per_mps',
-                     'max_pore_suction_pa'):
-            if not getattr(self, name) >= 0.0:
-                raise ConfigError(f'surf.{name} must be >= 0')
+        if not self.wet_motion_resistance_coeff >= 0.0:
+            raise ConfigError('surf.wet_motion_resistance_coeff must be >= 0')
 
 
 @dataclass(frozen=True)

@@ -318,8 +318,9 @@ def test_a_short_crested_sea_yaws_a_drifting_vehicle_through_the_strip_moments()
 
 def _soil_rows(coeff: float, x_m: float, suction_pa_per_mps: float = 0.0,
                command: float = 50.0, steps: int = 150) -> list:
-    sim = SimCore.from_config(overrides={'surf.wet_motion_resistance_coeff': coeff,
-                                         'surf.pore_suction_pa_per_mps': suction_pa_per_mps})
+    sim = SimCore.from_config(overrides={
+        'surf.wet_motion_resistance_coeff': coeff,
+        'saturated_sand.pore_suction_pa_per_mps': suction_pa_per_mps})
     sim.reset(x_m=x_m)
     return [sim.step(Actuation(command, command)) for _ in range(steps)][100:]
 
@@ -354,7 +355,7 @@ def test_pore_suction_lets_the_wet_sand_carry_the_surf_load_and_is_absent_on_dry
 
 
 def test_afloat_the_tracks_take_no_soil_force_whatever_the_suction():
-    sim = SimCore.from_config(overrides={'surf.pore_suction_pa_per_mps': 1e6})
+    sim = SimCore.from_config(overrides={'saturated_sand.pore_suction_pa_per_mps': 1e6})
     sim.reset('afloat')
     rows = [sim.step(Actuation(100, 100)) for _ in range(100)]
     assert all(t.port_force_n == 0.0 and t.stbd_force_n == 0.0 for t in rows)
