@@ -115,16 +115,16 @@ class SaturatedSandParams:
 
     Sheared faster than the pore water can flow in, saturated sand dilates, its pore
     pressure drops and the effective normal stress on the track patch rises by that
-    suction: linear in the slip velocity up to the cavitation limit (config
-    ``saturated_sand.*``; dukw_model.traction.pore_suction_pa).
+    suction: linear in the slip velocity and in the patch's contact pressure, up to the
+    cavitation limit (config ``saturated_sand.*``; dukw_model.traction.pore_suction_pa).
     """
 
-    pore_suction_pa_per_mps: float   # suction per m/s of slip velocity, saturated sand
+    suction_ratio_per_mps: float     # suction / contact pressure per m/s of slip velocity
     max_pore_suction_pa: float       # cavitation limit
 
     def __post_init__(self) -> None:
-        if not (self.pore_suction_pa_per_mps >= 0.0 and self.max_pore_suction_pa >= 0.0):
-            raise ConfigError('saturated_sand pore_suction_pa_per_mps and max_pore_suction_pa '
+        if not (self.suction_ratio_per_mps >= 0.0 and self.max_pore_suction_pa >= 0.0):
+            raise ConfigError('saturated_sand suction_ratio_per_mps and max_pore_suction_pa '
                               'must be >= 0')
 
 

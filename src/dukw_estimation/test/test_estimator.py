@@ -498,7 +498,7 @@ def test_the_surface_observer_uses_the_saturated_sands_strength_where_water_cove
     # suction, the shared saturated_sand.*); the estimator's force model is the same, so the
     # track forces in the surf do not read as less water. Dry sand: the plain Wong force.
     contact = make().contact
-    assert VEHICLE.saturated_sand.pore_suction_pa_per_mps > 0.0
+    assert VEHICLE.saturated_sand.suction_ratio_per_mps > 0.0
     assert contact.saturation(-3.0, 0.0, 1.0) == 0.0           # above the waterline
     assert contact.saturation(3.0, 0.0, 1.0) == 1.0            # the patch under water
     assert 0.0 < contact.saturation(0.0, 0.0, 1.0) < 1.0       # across the waterline

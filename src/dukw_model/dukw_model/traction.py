@@ -34,14 +34,17 @@ ArrayLike = float | np.ndarray
 NO_SUCTION = SaturatedSandParams(0.0, 0.0)
 
 
-def pore_suction_pa(slip_speed_mps: ArrayLike, saturation: float,
+def pore_suction_pa(slip_speed_mps: ArrayLike, pressure_pa: ArrayLike, saturation: float,
                     suction: SaturatedSandParams) -> ArrayLike:
-    """Pore under-pressure s = saturation x min(rate |v_slip|, cavitation limit), Pa (>= 0)."""
+    """Pore under-pressure s = saturation x min(ratio |v_slip| p, cavitation limit), Pa (>= 0):
+    growing with the slip velocity and with the patch's contact pressure p (the dilating
+    layer is the one the grousers pressed into the sand shear)."""
     sat = min(max(float(saturation), 0.0), 1.0)
-    rate, limit = suction.pore_suction_pa_per_mps, suction.max_pore_suction_pa
-    if is_scalar(slip_speed_mps):
-        return sat * min(rate * abs(float(slip_speed_mps)), limit)
-    out = sat * np.minimum(rate * np.abs(np.asarray(slip_speed_mps, dtype=float)), limit)
+    ratio, limit = suction.suction_ratio_per_mps, suction.max_pore_suction_pa
+    if is_scalar(slip_speed_mps) and is_scalar(pressure_pa):
+        return sat * min(ratio * abs(float(slip_speed_mps)) * float(pressure_pa), limit)
+    out = sat * np.minimum(ratio * np.abs(np.asarray(slip_speed_mps, dtype=float))
+                           * np.asarray(pressure_pa, dtype=float), limit)
     return float(out) if out.ndim == 0 else out
 
 
@@ -152,9 +155,11 @@ def track_force_n(track_speed_mps: ArrayLike, ground_speed_mps: ArrayLike,
     """
     v_t = np.asarray(track_speed_mps, dtype=float)
     suction_pa = 0.0
-    if saturation > 0.0 and suction.pore_suction_pa_per_mps > 0.0:
+    if saturation > 0.0 and suction.suction_ratio_per_mps > 0.0:
+        pressure_pa = np.maximum(np.asarray(effective_weight_n, dtype=float), 0.0) \
+            / contact_area_m2
         suction_pa = pore_suction_pa(v_t - np.asarray(ground_speed_mps, dtype=float),
-                                     saturation, suction)
+                                     pressure_pa, saturation, suction)
     h = tractive_force_n(slip(v_t, ground_speed_mps), effective_weight_n, soil,
                          contact_area_m2, contact_length_m, suction_pa)
     out = np.where(v_t >= 0.0, h, -h)

@@ -119,16 +119,19 @@ def test_the_scalar_path_gives_the_array_path_bit_for_bit():
 
 
 # ------------------------------------------------ pore suction of saturated sand (issue 13)
-SUCTION = SaturatedSandParams(pore_suction_pa_per_mps=20000.0, max_pore_suction_pa=100000.0)
+SUCTION = SaturatedSandParams(suction_ratio_per_mps=2.0, max_pore_suction_pa=100000.0)
 
 
-def test_pore_suction_grows_with_slip_velocity_and_saturation_up_to_cavitation():
-    assert traction.pore_suction_pa(0.0, 1.0, SUCTION) == 0.0            # no shearing
-    assert traction.pore_suction_pa(1.0, 0.0, SUCTION) == 0.0            # dry sand
-    assert traction.pore_suction_pa(-0.5, 1.0, SUCTION) == pytest.approx(10000.0)
-    assert traction.pore_suction_pa(0.5, 0.5, SUCTION) == pytest.approx(5000.0)
-    assert traction.pore_suction_pa(50.0, 1.0, SUCTION) == pytest.approx(100000.0)
-    arr = traction.pore_suction_pa(np.array([0.0, 1.0, 9.0]), 1.0, SUCTION)
+def test_pore_suction_grows_with_slip_velocity_pressure_and_saturation_up_to_cavitation():
+    p = 10000.0                                                         # contact pressure, Pa
+    assert traction.pore_suction_pa(0.0, p, 1.0, SUCTION) == 0.0        # no shearing
+    assert traction.pore_suction_pa(1.0, p, 0.0, SUCTION) == 0.0        # dry sand
+    assert traction.pore_suction_pa(1.0, 0.0, 1.0, SUCTION) == 0.0      # not pressed in
+    assert traction.pore_suction_pa(-0.5, p, 1.0, SUCTION) == pytest.approx(10000.0)
+    assert traction.pore_suction_pa(0.5, p, 0.5, SUCTION) == pytest.approx(5000.0)
+    assert traction.pore_suction_pa(0.5, 2 * p, 1.0, SUCTION) == pytest.approx(20000.0)
+    assert traction.pore_suction_pa(50.0, p, 1.0, SUCTION) == pytest.approx(100000.0)
+    arr = traction.pore_suction_pa(np.array([0.0, 1.0, 9.0]), p, 1.0, SUCTION)
     assert arr == pytest.approx([0.0, 20000.0, 100000.0])
     with pytest.raises(ValueError):
         SaturatedSandParams(-1.0, 0.0)
@@ -150,9 +153,9 @@ def test_saturated_sand_strengthens_with_slip_velocity_within_the_cavitation_bou
     plain = [traction.track_force_n(v_t, 0.2, 1000.0, SOIL, A / 2, L) for v_t in speeds]
     assert all(f > p for f, p in zip(forces, plain, strict=True))
     assert forces == sorted(forces)
-    # at slip velocity 1.0 m/s: 20 kPa over the patch adds A/2 x 20 kPa x tan(phi)
+    # at slip velocity 1.0 m/s the suction is 2 x the contact pressure: the normal force x 3
     gain = forces[2] / plain[2]
-    expected = (A / 2 * SOIL.cohesion_pa + (1000.0 + A / 2 * 20000.0)
+    expected = (A / 2 * SOIL.cohesion_pa + 3.0 * 1000.0
                 * math.tan(SOIL.friction_angle_rad)) / (
         A / 2 * SOIL.cohesion_pa + 1000.0 * math.tan(SOIL.friction_angle_rad))
     assert gain == pytest.approx(expected, rel=1e-9)

@@ -160,6 +160,8 @@ class SimCore:
         dry = params.dry_soil or vehicle.soil
         self._dry_soil = _soil_with_floor(dry, land.min_shear_modulus_m)
         self._suction = vehicle.saturated_sand
+        # the sea state's wave height (H or Hs): the surf's liquefaction of the sand
+        self._wave_height_m = 0.0 if self.world.calm else params.waves.significant_height_m
         s = vehicle.sensors
         n = self.hull.station_x_m.size
         self._n_stations = n
@@ -403,7 +405,7 @@ class SimCore:
         if self.x < self.params.world.wet_sand_start_x_m:
             return TrackContact(w_eff / 2.0, self._dry_soil, self._track_area, self._track_len)
         saturation = 0.0
-        if self._suction.pore_suction_pa_per_mps > 0.0:
+        if self._suction.suction_ratio_per_mps > 0.0:
             saturation = saturated_share(self._water_over_tracks())
         return TrackContact(w_eff / 2.0, self._wet_soil, self._track_area, self._track_len,
                             self._suction, saturation)
@@ -448,8 +450,8 @@ class SimCore:
             terms += slope_gravity(self._weight, imm.buoyancy_n,
                                    self.world.beach.gradient(self.x), c, s)
             if self.params.surf.wet_motion_resistance_coeff > 0.0:
-                terms += surf_resistance(w_eff, self._track_wetness(), drives.ground,
-                                         self.params.surf, half)
+                terms += surf_resistance(w_eff, self._track_wetness(), self._wave_height_m,
+                                         drives.ground, self.params.surf, half)
         terms += propulsion(thrust, wat.prop_walk_ratio, self.params.propeller.x_m, half)
         terms.append(hydrodynamic_drag(rel_water[0], rel_water[1], self.r, imm.fraction, wat))
         ex, ey, en = self._external
