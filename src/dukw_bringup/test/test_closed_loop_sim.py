@@ -134,7 +134,9 @@ def test_sea_to_land_in_waves_changes_mode_once_each(feedback):
     waves = {'waves.model': 'irregular', 'waves.significant_height_m': 0.28,
              'waves.peak_period_s': 3.6}
     loop = closed_loop(waves, x_m=12.0, yaw_rad=math.pi, seed=1, feedback=feedback)
-    loop.run(20.0, cmd=(1.0, 0.0))
+    # 28 s (was 20): the surf's wet-sand resistance (issue 13, sim_node surf.*) holds the
+    # vehicle to ~0.4-0.8 m/s for the ~4 m from the touchdown to the dry sand
+    loop.run(28.0, cmd=(1.0, 0.0))
     assert [m for _, m, _ in loop.record.modes] == [Mode.WATER, Mode.TRANSITION, Mode.LAND]
     # up on the sand (the waves' rotation yaws the hull in the surf, issue 13: the truth-fed
     # run ends ~4 deg off its heading at x -4.9 m, the EKF-fed one at -5.9 m)

@@ -238,7 +238,7 @@ def vehicle_specs(*groups: str) -> list[ParamSpec]:
     from dukw_common import vehicle as v
     classes = {'vehicle': v.VehicleParams, 'drivetrain': v.DrivetrainParams,
                'soil': v.SoilParams, 'limits': v.LimitParams, 'site': v.SiteParams,
-               'sensors': v.SensorMounts}
+               'sensors': v.SensorMounts, 'saturated_sand': v.SaturatedSandParams}
     specs = []
     for group in groups or tuple(classes):
         for name in classes[group].__dataclass_fields__:

@@ -110,6 +110,25 @@ class SoilParams:
 
 
 @dataclass(frozen=True)
+class SaturatedSandParams:
+    """Dilatancy hardening of the saturated beach sand the tracks shear (issue 13).
+
+    Sheared faster than the pore water can flow in, saturated sand dilates, its pore
+    pressure drops and the effective normal stress on the track patch rises by that
+    suction: linear in the slip velocity and in the patch's contact pressure, up to the
+    cavitation limit (config ``saturated_sand.*``; dukw_model.traction.pore_suction_pa).
+    """
+
+    suction_ratio_per_mps: float     # suction / contact pressure per m/s of slip velocity
+    max_pore_suction_pa: float       # cavitation limit
+
+    def __post_init__(self) -> None:
+        if not (self.suction_ratio_per_mps >= 0.0 and self.max_pore_suction_pa >= 0.0):
+            raise ConfigError('saturated_sand suction_ratio_per_mps and max_pore_suction_pa '
+                              'must be >= 0')
+
+
+@dataclass(frozen=True)
 class LimitParams:
     """Operating limits on inclines (vehicle.md section 3)."""
 
@@ -150,6 +169,11 @@ def site_params(params: Mapping[str, ParamValue]) -> SiteParams:
     return build_settings(SiteParams, params, 'site')
 
 
+def saturated_sand_params(params: Mapping[str, ParamValue]) -> SaturatedSandParams:
+    """Build SaturatedSandParams from dotted parameters (``saturated_sand.*``)."""
+    return build_settings(SaturatedSandParams, params, 'saturated_sand')
+
+
 def soil_params(params: Mapping[str, ParamValue], preset: str | None = None) -> SoilParams:
     """Build SoilParams: a named preset from ``soil_presets.*``, else the ``soil.*`` values."""
     if preset:
@@ -171,12 +195,14 @@ class Vehicle:
     limits: LimitParams
     site: SiteParams
     sensors: SensorMounts
+    saturated_sand: SaturatedSandParams
 
     @classmethod
     def from_params(cls, params: Mapping[str, ParamValue]) -> 'Vehicle':
         """Build from dotted parameters (a node's declared values or dukw_common.config)."""
         return cls(vehicle_params(params), drivetrain_params(params), soil_params(params),
-                   limit_params(params), site_params(params), sensor_mounts(params))
+                   limit_params(params), site_params(params), sensor_mounts(params),
+                   saturated_sand_params(params))
 
     @classmethod
     def load(cls, path: str | None = None) -> 'Vehicle':

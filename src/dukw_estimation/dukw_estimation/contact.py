@@ -234,5 +234,23 @@ class ContactModel:
                                              min(volume, body.displaced_volume_m3),
                                              self.slope_rad, body.water_density_kgpm3,
                                              body.gravity_mps2)
-        return float(traction.track_force_n(track_mps, ground_mps, 0.5 * weight, self.soil,
-                                            self.track_area_m2, body.track_contact_length_m))
+        return self.track_force_n(track_mps, ground_mps, 0.5 * weight,
+                                  self.saturation(waterline_distance_m, surface_m, heading_cos))
+
+    def saturation(self, waterline_distance_m: float, surface_m: float,
+                   heading_cos: float) -> float:
+        """Share of the tracks' patches with water over the sand (the estimated surface
+        ``surface_m`` over a beach of the estimated slope), 0..1: saturated sand."""
+        sin_t = math.sin(self.slope_rad)
+        return traction.saturated_share(surface_m + waterline_distance_m * sin_t,
+                                        heading_cos * sin_t,
+                                        self.vehicle.body.track_contact_length_m)
+
+    def track_force_n(self, track_mps: float, ground_mps: float, weight_n: float,
+                      saturation: float) -> float:
+        """The shared traction model's soil force of one track carrying ``weight_n`` on sand
+        this much saturated (the saturated sand's pore suction, ``vehicle.saturated_sand``), N."""
+        return float(traction.track_force_n(track_mps, ground_mps, weight_n, self.soil,
+                                            self.track_area_m2,
+                                            self.vehicle.body.track_contact_length_m,
+                                            self.vehicle.saturated_sand, saturation))

@@ -265,11 +265,13 @@ class Estimator:
         body = self.vehicle.body
         ground = ground_speeds(self.ekf.x, body.hull_separation_m)
         speeds = (tracks.port.speed_mps, tracks.stbd.speed_mps)
+        x = self.ekf.x
+        saturation = self.contact.saturation(
+            x[Idx.S], x[Idx.ETA], math.cos(x[Idx.YAW] - self.settings.seaward_yaw_rad))
         for k in range(2):
             slips[k] = traction.slip(speeds[k], ground[k])
-            predicted[k] = traction.track_force_n(speeds[k], ground[k], 0.5 * weight_n,
-                                                  self.contact.soil, self.contact.track_area_m2,
-                                                  body.track_contact_length_m)
+            predicted[k] = self.contact.track_force_n(speeds[k], ground[k], 0.5 * weight_n,
+                                                      saturation)
         return slips, predicted
 
     def health(self, now_s: float) -> list[Health]:

@@ -275,7 +275,8 @@ def test_lying_still_in_a_trough_is_on_the_sand_though_the_mean_surface_would_fl
 
 def _surf_run(est, true_surface_m, slip_, seconds=5.0, x0=5.0, track_mps=0.5):
     """Crawl seaward on the slope with both tracks slipping by slip_, under a surface
-    true_surface_m off the mean; the track forces are the Wong forces of the true weight."""
+    true_surface_m off the mean; the track forces are the Wong forces of the true weight
+    (with the saturated sand's pore suction where the true surface covers the sand)."""
     from dukw_model import buoyancy
     slope = VEHICLE.site.beach_slope_rad
     body, drive = VEHICLE.body, VEHICLE.drivetrain
@@ -299,9 +300,12 @@ def _surf_run(est, true_surface_m, slip_, seconds=5.0, x0=5.0, track_mps=0.5):
             est.add_gps_fix(fix(t, x, 0.0))
             est.add_gps_velocity(GpsVelocity(t, u * math.cos(slope), 0.0))
         if k % 5 == 0:
-            soil_n = traction.tractive_force_n(slip_, 0.5 * weight, soil,
-                                               est.contact.track_area_m2,
-                                               body.track_contact_length_m)
+            saturation = traction.saturated_share(true_surface_m + s_true * math.sin(slope),
+                                                  math.sin(slope), body.track_contact_length_m)
+            soil_n = traction.track_force_n(track_mps, u, 0.5 * weight, soil,
+                                            est.contact.track_area_m2,
+                                            body.track_contact_length_m,
+                                            VEHICLE.saturated_sand, saturation)
             sides = []
             for port in (True, False):    # the motors also turn the drivetrain
                 force = soil_n + drive.track_friction_n(port)
@@ -487,3 +491,18 @@ def test_asking_for_the_estimate_changes_nothing():
         for odometry_again, traction_again in seen_often[5 * k:5 * k + 5]:
             _same(odometry_again, odometry)
             _same(traction_again, traction_)
+
+
+def test_the_surface_observer_uses_the_saturated_sands_strength_where_water_covers_the_sand():
+    # issue 13: the simulator's saturated sand carries more force with the slip velocity (pore
+    # suction, the shared saturated_sand.*); the estimator's force model is the same, so the
+    # track forces in the surf do not read as less water. Dry sand: the plain Wong force.
+    contact = make().contact
+    assert VEHICLE.saturated_sand.suction_ratio_per_mps > 0.0
+    assert contact.saturation(-3.0, 0.0, 1.0) == 0.0           # above the waterline
+    assert contact.saturation(3.0, 0.0, 1.0) == 1.0            # the patch under water
+    assert 0.0 < contact.saturation(0.0, 0.0, 1.0) < 1.0       # across the waterline
+    plain = float(traction.track_force_n(1.2, 0.4, 1000.0, contact.soil, contact.track_area_m2,
+                                         VEHICLE.body.track_contact_length_m))
+    assert contact.track_force_n(1.2, 0.4, 1000.0, 0.0) == plain
+    assert contact.track_force_n(1.2, 0.4, 1000.0, 1.0) > plain

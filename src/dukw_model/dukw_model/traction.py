@@ -6,6 +6,13 @@ every function takes floats or numpy arrays.
     i   = (v_t - v_r) / v_t                       (signed slip)
     H   = sgn(i) (A c + W_e tan phi) [1 - k/(|i| l) (1 - exp(-|i| l / k))]
     W_e = (Delta - rho g V) cos(theta)
+
+In saturated sand (under the surf) shearing fast dilates the sand faster than the pore water
+can flow in: the pore pressure drops and the effective normal stress on the shear surface
+rises by that suction (dilatancy hardening). ``SaturatedSandParams`` (config
+``saturated_sand.*``) adds it to the strength,
+A c + (W_e + A s) tan phi, with s growing with the slip velocity |v_t - v_r| up to the
+cavitation limit (``pore_suction_pa``); on dry sand and with no slip it is zero.
 """
 from __future__ import annotations
 
@@ -15,9 +22,30 @@ import numpy as np
 
 from dukw_model.scalars import is_scalar
 
-from dukw_common.vehicle import SoilParams
+from dukw_common.vehicle import SaturatedSandParams, SoilParams
 
 ArrayLike = float | np.ndarray
+
+
+#: No dilatancy hardening: the plain (dry-sand) Wong force. The saturated sand's (van Os 1977;
+#: Miedema, The Delft Sand, Clay and Rock Cutting Model, 2014: dilatancy-limited cutting forces
+#: of saturated sand proportional to the velocity, up to cavitation at rho_w g (10 m + depth))
+#: is the shared config's ``saturated_sand.*`` (Vehicle.saturated_sand).
+NO_SUCTION = SaturatedSandParams(0.0, 0.0)
+
+
+def pore_suction_pa(slip_speed_mps: ArrayLike, pressure_pa: ArrayLike, saturation: float,
+                    suction: SaturatedSandParams) -> ArrayLike:
+    """Pore under-pressure s = saturation x min(ratio |v_slip| p, cavitation limit), Pa (>= 0):
+    growing with the slip velocity and with the patch's contact pressure p (the dilating
+    layer is the one the grousers pressed into the sand shear)."""
+    sat = min(max(float(saturation), 0.0), 1.0)
+    ratio, limit = suction.suction_ratio_per_mps, suction.max_pore_suction_pa
+    if is_scalar(slip_speed_mps) and is_scalar(pressure_pa):
+        return sat * min(ratio * abs(float(slip_speed_mps)) * float(pressure_pa), limit)
+    out = sat * np.minimum(ratio * np.abs(np.asarray(slip_speed_mps, dtype=float))
+                           * np.asarray(pressure_pa, dtype=float), limit)
+    return float(out) if out.ndim == 0 else out
 
 
 def slip(track_speed_mps: ArrayLike, ground_speed_mps: ArrayLike,
@@ -38,6 +66,19 @@ def slip(track_speed_mps: ArrayLike, ground_speed_mps: ArrayLike,
     denom = sign * np.maximum(np.abs(v_t), min_track_speed_mps)
     i = np.clip((v_t - v_r) / denom, -1.0, 1.0)
     return float(i) if i.ndim == 0 else i
+
+
+def saturated_share(depth_at_centre_m: float, depth_per_m: float, length_m: float) -> float:
+    """Share of a track patch of ``length_m`` with water over the sand, 0..1, where the water
+    depth over the sand is ``depth_at_centre_m`` at the patch's centre and changes by
+    ``depth_per_m`` along it (a plane surface over a plane beach): there the sand under the
+    track is saturated."""
+    half = 0.5 * length_m
+    if abs(depth_per_m) * half < 1e-9:
+        return 1.0 if depth_at_centre_m > 0.0 else 0.0
+    zero_m = -depth_at_centre_m / depth_per_m          # where the depth crosses zero
+    wet_m = half - zero_m if depth_per_m > 0.0 else zero_m + half
+    return min(max(wet_m / length_m, 0.0), 1.0)
 
 
 def shear_development(slip_abs: ArrayLike, contact_length_m: float,
@@ -64,49 +105,63 @@ def shear_development(slip_abs: ArrayLike, contact_length_m: float,
 
 
 def max_traction_n(effective_weight_n: ArrayLike, soil: SoilParams,
-                   contact_area_m2: float) -> ArrayLike:
-    """Fully developed shear strength of the contact patch: A c + W_e tan(phi), N."""
+                   contact_area_m2: float, suction_pa: ArrayLike = 0.0) -> ArrayLike:
+    """Fully developed shear strength of the contact patch: A c + (W_e + A s) tan(phi), N
+    (s: the pore suction, ``pore_suction_pa``)."""
     w = np.maximum(np.asarray(effective_weight_n, dtype=float), 0.0)
+    if np.any(np.asarray(suction_pa) != 0.0):
+        w = w + contact_area_m2 * np.asarray(suction_pa, dtype=float)
     out = contact_area_m2 * soil.cohesion_pa + w * np.tan(soil.friction_angle_rad)
     return float(out) if np.ndim(out) == 0 else out
 
 
 def tractive_force_n(slip_: ArrayLike, effective_weight_n: ArrayLike, soil: SoilParams,
-                     contact_area_m2: float, contact_length_m: float) -> ArrayLike:
+                     contact_area_m2: float, contact_length_m: float,
+                     suction_pa: ArrayLike = 0.0) -> ArrayLike:
     """Modified Wong tractive force H, N, signed like the slip.
 
     ``contact_area_m2`` and ``effective_weight_n`` are for the tracks the force is
     wanted for: A = 2 b l and the whole W_e for the vehicle, or b l and W_e / 2
     for one track. No weight on the tracks (afloat) gives no cohesion either:
-    the patch is off the ground.
+    the patch is off the ground. ``suction_pa`` (pore suction of saturated sand,
+    ``pore_suction_pa``) adds A s to the normal force while the patch is on the ground.
     """
-    if is_scalar(slip_) and is_scalar(effective_weight_n):        # scalar path
+    if is_scalar(slip_) and is_scalar(effective_weight_n) and is_scalar(suction_pa):
         i, w = float(slip_), max(float(effective_weight_n), 0.0)
         sign = math.copysign(1.0, i) if i != 0.0 else 0.0      # as np.sign: +0 at either zero
         tan_phi = float(np.tan(soil.friction_angle_rad))       # numpy: the same bits
-        strength = contact_area_m2 * soil.cohesion_pa + w * tan_phi if w > 0.0 else 0.0
+        normal = w + contact_area_m2 * float(suction_pa) if suction_pa else w
+        strength = contact_area_m2 * soil.cohesion_pa + normal * tan_phi if w > 0.0 else 0.0
         return sign * strength * shear_development(i, contact_length_m, soil.shear_modulus_m)
     i = np.asarray(slip_, dtype=float)
     w = np.maximum(np.asarray(effective_weight_n, dtype=float), 0.0)
-    strength = np.where(w > 0.0, max_traction_n(w, soil, contact_area_m2), 0.0)
+    strength = np.where(w > 0.0, max_traction_n(w, soil, contact_area_m2, suction_pa), 0.0)
     out = np.sign(i) * strength * shear_development(i, contact_length_m, soil.shear_modulus_m)
     return float(out) if out.ndim == 0 else out
 
 
 def track_force_n(track_speed_mps: ArrayLike, ground_speed_mps: ArrayLike,
                   effective_weight_n: ArrayLike, soil: SoilParams, contact_area_m2: float,
-                  contact_length_m: float) -> ArrayLike:
+                  contact_length_m: float, suction: SaturatedSandParams = NO_SUCTION,
+                  saturation: float = 0.0) -> ArrayLike:
     """Soil force on the vehicle from a track at ``track_speed_mps`` over the ground at
     ``ground_speed_mps``, N (+ forward).
 
     The Wong force is signed like the slip, which is relative to the track's own direction;
     a track running backwards pushes backwards, so the force on the vehicle is that force
     times the sign of the track speed (a stopped track counts as forward: it brakes a
-    vehicle moving forward, and pushes one moving backward forward).
+    vehicle moving forward, and pushes one moving backward forward). In saturated sand
+    (``saturation`` > 0) the pore suction of the slip velocity strengthens the soil.
     """
     v_t = np.asarray(track_speed_mps, dtype=float)
+    suction_pa = 0.0
+    if saturation > 0.0 and suction.suction_ratio_per_mps > 0.0:
+        pressure_pa = np.maximum(np.asarray(effective_weight_n, dtype=float), 0.0) \
+            / contact_area_m2
+        suction_pa = pore_suction_pa(v_t - np.asarray(ground_speed_mps, dtype=float),
+                                     pressure_pa, saturation, suction)
     h = tractive_force_n(slip(v_t, ground_speed_mps), effective_weight_n, soil,
-                         contact_area_m2, contact_length_m)
+                         contact_area_m2, contact_length_m, suction_pa)
     out = np.where(v_t >= 0.0, h, -h)
     return float(out) if out.ndim == 0 else out
 

@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from dukw_common.vehicle import SoilParams
+from dukw_common.vehicle import SaturatedSandParams, SoilParams
 from dukw_model import traction
 
 SOIL = SoilParams(cohesion_pa=150.0, friction_angle_rad=math.radians(9.93), shear_modulus_m=0.053)
@@ -116,3 +116,61 @@ def test_the_scalar_path_gives_the_array_path_bit_for_bit():
             one = tr.tractive_force_n(slip_, w, soil, 0.5, 1.2)
             many = tr.tractive_force_n(np.array([slip_]), np.array([w]), soil, 0.5, 1.2)[0]
             assert one == many and math.copysign(1.0, one) == math.copysign(1.0, many)
+
+
+# ------------------------------------------------ pore suction of saturated sand (issue 13)
+SUCTION = SaturatedSandParams(suction_ratio_per_mps=2.0, max_pore_suction_pa=100000.0)
+
+
+def test_pore_suction_grows_with_slip_velocity_pressure_and_saturation_up_to_cavitation():
+    p = 10000.0                                                         # contact pressure, Pa
+    assert traction.pore_suction_pa(0.0, p, 1.0, SUCTION) == 0.0        # no shearing
+    assert traction.pore_suction_pa(1.0, p, 0.0, SUCTION) == 0.0        # dry sand
+    assert traction.pore_suction_pa(1.0, 0.0, 1.0, SUCTION) == 0.0      # not pressed in
+    assert traction.pore_suction_pa(-0.5, p, 1.0, SUCTION) == pytest.approx(10000.0)
+    assert traction.pore_suction_pa(0.5, p, 0.5, SUCTION) == pytest.approx(5000.0)
+    assert traction.pore_suction_pa(0.5, 2 * p, 1.0, SUCTION) == pytest.approx(20000.0)
+    assert traction.pore_suction_pa(50.0, p, 1.0, SUCTION) == pytest.approx(100000.0)
+    arr = traction.pore_suction_pa(np.array([0.0, 1.0, 9.0]), p, 1.0, SUCTION)
+    assert arr == pytest.approx([0.0, 20000.0, 100000.0])
+    with pytest.raises(ValueError):
+        SaturatedSandParams(-1.0, 0.0)
+
+
+def test_dry_or_unsheared_sand_gives_the_plain_wong_force():
+    for v_t, v_r in ((1.2, 0.8), (0.5, 0.5), (-1.0, -0.4)):
+        plain = traction.track_force_n(v_t, v_r, 1000.0, SOIL, A / 2, L)
+        dry = traction.track_force_n(v_t, v_r, 1000.0, SOIL, A / 2, L, SUCTION, 0.0)
+        assert dry == plain
+    afloat = traction.track_force_n(1.2, 0.2, 0.0, SOIL, A / 2, L, SUCTION, 1.0)
+    assert afloat == 0.0                                   # off the ground: no patch at all
+
+
+def test_saturated_sand_strengthens_with_slip_velocity_within_the_cavitation_bound():
+    speeds = (0.4, 0.8, 1.2, 2.0)
+    forces = [traction.track_force_n(v_t, 0.2, 1000.0, SOIL, A / 2, L, SUCTION, 1.0)
+              for v_t in speeds]
+    plain = [traction.track_force_n(v_t, 0.2, 1000.0, SOIL, A / 2, L) for v_t in speeds]
+    assert all(f > p for f, p in zip(forces, plain, strict=True))
+    assert forces == sorted(forces)
+    # at slip velocity 1.0 m/s the suction is 2 x the contact pressure: the normal force x 3
+    gain = forces[2] / plain[2]
+    expected = (A / 2 * SOIL.cohesion_pa + 3.0 * 1000.0
+                * math.tan(SOIL.friction_angle_rad)) / (
+        A / 2 * SOIL.cohesion_pa + 1000.0 * math.tan(SOIL.friction_angle_rad))
+    assert gain == pytest.approx(expected, rel=1e-9)
+    bound = traction.max_traction_n(1000.0, SOIL, A / 2, SUCTION.max_pore_suction_pa)
+    assert traction.track_force_n(50.0, 0.0, 1000.0, SOIL, A / 2, L, SUCTION, 1.0) <= bound
+    braking = traction.track_force_n(0.2, 1.2, 1000.0, SOIL, A / 2, L, SUCTION, 1.0)
+    assert braking < traction.track_force_n(0.2, 1.2, 1000.0, SOIL, A / 2, L) < 0.0
+
+
+def test_saturated_share_of_a_patch_on_a_plane_beach():
+    # depth over the sand d0 + g x along a 1 m patch: wet where it is > 0
+    assert traction.saturated_share(0.0, 0.1, 1.0) == pytest.approx(0.5)
+    assert traction.saturated_share(0.0, -0.1, 1.0) == pytest.approx(0.5)
+    assert traction.saturated_share(0.025, 0.1, 1.0) == pytest.approx(0.75)
+    assert traction.saturated_share(-1.0, 0.1, 1.0) == 0.0
+    assert traction.saturated_share(1.0, 0.1, 1.0) == 1.0
+    assert traction.saturated_share(0.01, 0.0, 1.0) == 1.0         # level water over the patch
+    assert traction.saturated_share(-0.01, 0.0, 1.0) == 0.0

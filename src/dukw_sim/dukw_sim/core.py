@@ -32,9 +32,9 @@ from dukw_model.propeller import prop_thrust_n, propeller_thrust_factor
 from dukw_sim.forces import (LATERAL_POINTS, BodyForces, Immersion, WaveForcing, WaveMoments,
                              drivetrain_friction_n, hydrodynamic_drag, immersion,
                              lateral_resistance, odom_force, paddle_wrench, propulsion,
-                             rolling_resistance, slope_gravity, sum_wrenches, surf_resistance,
-                             track_paddle_n, track_wetness, water_yaw_rate_rps, wave_forcing,
-                             wave_moments)
+                             rolling_resistance, saturated_share, slope_gravity, sum_wrenches,
+                             surf_resistance, track_paddle_n, track_wetness, water_yaw_rate_rps,
+                             wave_forcing, wave_moments)
 from dukw_sim.hull import HullGeometry, Seakeeping
 from dukw_sim.land import TrackContact, TrackLinear, linearise, motor_limited_speed
 from dukw_sim.params import SimParams, apply_overrides
@@ -159,6 +159,9 @@ class SimCore:
         self._wet_soil = _soil_with_floor(vehicle.soil, land.min_shear_modulus_m)
         dry = params.dry_soil or vehicle.soil
         self._dry_soil = _soil_with_floor(dry, land.min_shear_modulus_m)
+        self._suction = vehicle.saturated_sand
+        # the sea state's wave height (H or Hs): the surf's liquefaction of the sand
+        self._wave_height_m = 0.0 if self.world.calm else params.waves.significant_height_m
         s = vehicle.sensors
         n = self.hull.station_x_m.size
         self._n_stations = n
@@ -388,14 +391,25 @@ class SimCore:
                                  track_imm)
             paddle.append(pad)
             others.append(fric + pad)
-        soil = self._dry_soil if self.x < p.world.wet_sand_start_x_m else self._wet_soil
-        contact = TrackContact(w_eff / 2.0, soil, self._track_area, self._track_len) \
-            if w_eff > 0.0 else None
+        contact = self._track_contact(w_eff)
         # the speed loops give under load; at a zero command they hold the track (brake)
         loop_k = tuple(self._loop_k if targets[i] != 0.0 else math.inf for i in range(2))
         lin = linearise(contact, tuple(self.ref), ground, tuple(others), loop_k,
                         tuple(self.track_speed))
         return _Drives(ground, others, paddle, loop_k, contact, lin)
+
+    def _track_contact(self, w_eff: float) -> TrackContact | None:
+        """The tracks' patches on the sand: dry or wet soil by position; under the surf the
+        saturated share of the patches (sand under water) takes the pore suction."""
+        if w_eff <= 0.0:
+            return None
+        if self.x < self.params.world.wet_sand_start_x_m:
+            return TrackContact(w_eff / 2.0, self._dry_soil, self._track_area, self._track_len)
+        saturation = 0.0
+        if self._suction.suction_ratio_per_mps > 0.0:
+            saturation = saturated_share(self._water_over_tracks())
+        return TrackContact(w_eff / 2.0, self._wet_soil, self._track_area, self._track_len,
+                            self._suction, saturation)
 
     def _thrust_n(self, act: Actuation, eta: np.ndarray) -> list[float]:
         """Port and starboard propeller thrust, N, with their depth under the surface."""
@@ -421,12 +435,15 @@ class SimCore:
         return water_yaw_rate_rps(areas, water, self.hull.station_x_m, self.hull.station_y_m,
                                   yaw_cs)
 
-    def _track_wetness(self) -> float:
-        """Share of the tracks' height under the surface (over the contact length), 0..1."""
+    def _water_over_tracks(self) -> np.ndarray:
+        """Height of the surface over the sand at the strips along the tracks' contact, m."""
         px, water = self._hydro()[:2]
         n = self._n_stations
-        over = (water.elevation_m[:n] - self.world.beach.heights_m(px[:n]))[self._track_strips]
-        return track_wetness(over, self.vehicle.body.hull_clearance_m)
+        return (water.elevation_m[:n] - self.world.beach.heights_m(px[:n]))[self._track_strips]
+
+    def _track_wetness(self) -> float:
+        """Share of the tracks' height under the surface (over the contact length), 0..1."""
+        return track_wetness(self._water_over_tracks(), self.vehicle.body.hull_clearance_m)
 
     def _body_forces(self, drives: _Drives, imm: Immersion, waves: WaveForcing,
                      thrust: list[float], w_eff: float, rel_water: tuple,
@@ -442,8 +459,8 @@ class SimCore:
             terms += slope_gravity(self._weight, imm.buoyancy_n,
                                    self.world.beach.gradient(self.x), c, s)
             if self.params.surf.wet_motion_resistance_coeff > 0.0:
-                terms += surf_resistance(w_eff, self._track_wetness(), drives.ground,
-                                         self.params.surf, half)
+                terms += surf_resistance(w_eff, self._track_wetness(), self._wave_height_m,
+                                         drives.ground, self.params.surf, half)
         terms += propulsion(thrust, wat.prop_walk_ratio, self.params.propeller.x_m, half)
         terms.append(hydrodynamic_drag(*rel_water, imm.fraction, wat))
         ex, ey, en = self._external
@@ -589,8 +606,7 @@ class SimCore:
         total = m_x * du / dt - x0 - j_u * du
         turn = (i_z * dr / dt - n0 - j_r * dr) / half
         want = [0.5 * (total - turn), 0.5 * (total + turn)]
-        strength = float(traction.max_traction_n(contact.weight_per_track_n, contact.soil,
-                                                 contact.area_m2))
+        strength = contact.strength_n()
         limited = [False, False]
         force = []
         for i in range(2):
@@ -615,8 +631,7 @@ class SimCore:
         du = dt * (x0 + a[0] + a[1]) / (m_x - dt * j_u + dt * k_sum)
         dr = dt * (n0 + (a[1] - a[0]) * half) / (i_z - dt * j_r + dt * k_sum * half * half)
         force = [a[0] - loop_k[0] * (du - dr * half), a[1] - loop_k[1] * (du + dr * half)]
-        strength = float(traction.max_traction_n(contact.weight_per_track_n, contact.soil,
-                                                 contact.area_m2))
+        strength = contact.strength_n()
         limited = [False, False]
         for i in range(2):
             lo = max(-strength, -self._max_motor_n - others[i])

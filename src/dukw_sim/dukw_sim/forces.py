@@ -178,12 +178,23 @@ def track_wetness(water_over_ground_m: np.ndarray, track_height_m: float) -> flo
     return float(np.mean(np.clip(water_over_ground_m / track_height_m, 0.0, 1.0)))
 
 
-def surf_resistance(w_eff_n: float, wetness: float, ground_mps: tuple, surf: SurfParams,
-                    half_sep_m: float) -> list[Wrench]:
-    """Motion resistance of the wet, partly liquefied sand under the surf (sinkage and
-    bulldozing), a Coulomb resistance growing with the weight on the tracks and with the
-    share of the tracks under water, bounded by the tow tests' largest resistance."""
-    total_n = min(surf.wet_motion_resistance_coeff * wetness * w_eff_n, surf.max_resistance_n)
+def saturated_share(water_over_ground_m: np.ndarray) -> float:
+    """Share of the given points along the tracks with water standing over the sand: there
+    the sand under the tracks is saturated, 0 (dry beach) .. 1 (all under the surf)."""
+    if water_over_ground_m.size == 0:
+        return 0.0
+    return float(np.count_nonzero(water_over_ground_m > 0.0)) / water_over_ground_m.size
+
+
+def surf_resistance(w_eff_n: float, wetness: float, wave_height_m: float, ground_mps: tuple,
+                    surf: SurfParams, half_sep_m: float) -> list[Wrench]:
+    """Motion resistance of the sand the surf's waves liquefy (sinkage and bulldozing): a
+    Coulomb resistance growing with the weight on the tracks, with the share of the tracks
+    under water and with the waves' height (the depth of the wave-induced liquefaction grows
+    with the wave's pressure on the bed), bounded by the tow tests' largest resistance."""
+    liquefied = wave_height_m / surf.reference_wave_height_m
+    total_n = min(surf.wet_motion_resistance_coeff * liquefied * wetness * w_eff_n,
+                  surf.max_resistance_n)
     if total_n <= 0.0:
         return []
     return _coulomb_per_track(total_n / 2.0, ground_mps, half_sep_m)

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from dukw_common.vehicle import SoilParams
+from dukw_common.vehicle import SaturatedSandParams, SoilParams
 from dukw_model import traction
 
 _GRID = np.linspace(0.0, 1.0, 41)
@@ -36,11 +36,21 @@ class TrackContact:
     soil: SoilParams
     area_m2: float           # one track's patch, b l
     length_m: float
+    suction: SaturatedSandParams = traction.NO_SUCTION   # saturated sand's dilatancy
+    saturation: float = 0.0  # 0 dry sand .. 1 saturated (the tracks' wetted share)
 
     def forces_n(self, track_mps: np.ndarray, ground_mps: np.ndarray) -> np.ndarray:
         """Force on the vehicle from tracks at ``track_mps`` over ground speeds, N (+ forward)."""
         return np.asarray(traction.track_force_n(track_mps, ground_mps, self.weight_per_track_n,
-                                                 self.soil, self.area_m2, self.length_m))
+                                                 self.soil, self.area_m2, self.length_m,
+                                                 self.suction, self.saturation))
+
+    def strength_n(self, slipping: bool = False) -> float:
+        """The patch's shear strength, N: without pore suction (no slip velocity), or with
+        the most suction the saturated sand can hold (``slipping``: a bound at any slip)."""
+        suction_pa = self.saturation * self.suction.max_pore_suction_pa if slipping else 0.0
+        return float(traction.max_traction_n(self.weight_per_track_n, self.soil, self.area_m2,
+                                             suction_pa))
 
 
 @dataclass
@@ -60,8 +70,7 @@ def _compliant_speeds(contact: TrackContact, ref: np.ndarray, ground: np.ndarray
     h(v) = F_soil(v, g) + others - k (ref - v) rises with v; safeguarded Newton inside the
     bracket the soil's strength S gives: v in [ref - (S + o)/k, ref + (S - o)/k].
     """
-    strength = float(traction.max_traction_n(contact.weight_per_track_n, contact.soil,
-                                             contact.area_m2))
+    strength = contact.strength_n(slipping=True)
     lo = ref - (strength + others) / stiffness
     hi = ref + (strength - others) / stiffness
     v = np.clip(guess, lo, hi)

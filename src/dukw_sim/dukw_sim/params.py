@@ -149,12 +149,13 @@ class SeakeepingParams:
 class SurfParams:
     """Resistance of the wet, partly liquefied sand under the surf (issue 13)."""
 
-    wet_motion_resistance_coeff: float   # x W_e x the tracks' wetted share
+    wet_motion_resistance_coeff: float   # x W_e x the tracks' wetted share x H / reference
+    reference_wave_height_m: float       # the sea state the coefficient is for
     max_resistance_n: float              # the tow tests' largest resistance (bound)
 
     def __post_init__(self) -> None:
-        _positive(self, 'max_resistance_n')
-        if self.wet_motion_resistance_coeff < 0.0:
+        _positive(self, 'max_resistance_n', 'reference_wave_height_m')
+        if not self.wet_motion_resistance_coeff >= 0.0:
             raise ConfigError('surf.wet_motion_resistance_coeff must be >= 0')
 
 

@@ -22,7 +22,8 @@ from typing import Callable, Sequence
 import numpy as np
 import yaml
 
-from dukw_common.config import ConfigError, default_config_path
+from dukw_common.config import ConfigError, default_config_path, node_params
+from dukw_common.vehicle import Vehicle
 from dukw_model import state_space
 from dukw_sim import maneuver
 from dukw_sim.core import Actuation, SimCore
@@ -169,9 +170,19 @@ def inclines(ref: dict, res: Results, seed: int, config: str | None) -> None:
     res.series['inclines'] = rows
 
 
-def surf_force_per_track_n(run: maneuver.ManeuverRun) -> float:
-    """Mean soil force per track while the tracks carry weight in the surf, N."""
-    forces = [0.5 * (t.port_force_n + t.stbd_force_n) for t in run.rows
+def track_force_gain_n_per_a(config: str | None) -> float:
+    """The drivetrain's current-to-force gain of the parameter file, N/A (vehicle.md 3)."""
+    return Vehicle.from_params(node_params('sim_node', config)).drivetrain \
+        .track_force_gain_n_per_a
+
+
+def surf_force_per_track_n(run: maneuver.ManeuverRun, gain_n_per_a: float) -> float:
+    """Mean track force per track while the tracks carry weight in the surf, N, measured as
+    the paper measured it: motor current x the drivetrain's gain (vehicle.md 3 and 6; the
+    paper Kalman-filtered the currents, a mean over the window is unaffected by that). So
+    it holds the drivetrain friction, the no-load current and the tracks' paddling besides
+    the soil's force, as the boat's currents did."""
+    forces = [0.5 * gain_n_per_a * (t.port_current_a + t.stbd_current_a) for t in run.rows
               if t.medium == Medium.TRANSITION and t.effective_weight_n > 0.0]
     return float(np.mean(forces)) if forces else float('nan')
 
@@ -179,6 +190,7 @@ def surf_force_per_track_n(run: maneuver.ManeuverRun) -> float:
 def surf_transitions(ref: dict, res: Results, seed: int, config: str | None) -> None:
     """Tracks only through the day-1 surf, both ways: mean force per track in the surf."""
     rows = []
+    gain = track_force_gain_n_per_a(config)
     for direction, key in (('land-to-sea', 'land_to_sea_force_n'),
                            ('sea-to-land', 'sea_to_land_force_n')):
         low, high = ref[key]
@@ -186,7 +198,7 @@ def surf_transitions(ref: dict, res: Results, seed: int, config: str | None) -> 
             run = maneuver.transition(direction, cmd, ref['wave_height_m'],
                                       ref['wave_period_s'], ref['beach_slope_deg'],
                                       ref['duration_s'], seed, config)
-            force = surf_force_per_track_n(run)
+            force = surf_force_per_track_n(run, gain)
             res.checks.append(Check('surf_transitions', f'{direction} {cmd:g} % force', force,
                                     f'{low:g}-{high:g}', low, high, 'N'))
             rows.append((direction, cmd, force, low, high))

@@ -333,11 +333,21 @@ def test_the_yaw_damping_acts_against_the_waters_rotation_not_the_seabed():
     assert _heavily_damped_drift_yaw_rate_rms_dps(strip_moments=False) < 1e-6
 
 
-def _soil_force_n(coeff: float, x_m: float) -> float:
-    sim = SimCore.from_config(overrides={'surf.wet_motion_resistance_coeff': coeff})
+def _soil_rows(coeff: float, x_m: float, suction_ratio_per_mps: float = 0.0,
+               command: float = 50.0, steps: int = 150) -> list:
+    # the surf's resistance scales with the wave height: a 1 cm swell at the reference height
+    sim = SimCore.from_config(overrides={
+        'surf.wet_motion_resistance_coeff': coeff, 'surf.reference_wave_height_m': 0.01,
+        'waves.model': 'regular', 'waves.significant_height_m': 0.01,
+        'saturated_sand.suction_ratio_per_mps': suction_ratio_per_mps})
     sim.reset(x_m=x_m)
-    rows = [sim.step(Actuation(50, 50)) for _ in range(150)]
-    return float(np.mean([t.port_force_n + t.stbd_force_n for t in rows[100:]]))
+    return [sim.step(Actuation(command, command)) for _ in range(steps)][100:]
+
+
+def _soil_force_n(coeff: float, x_m: float, suction_ratio_per_mps: float = 0.0,
+                  command: float = 50.0) -> float:
+    rows = _soil_rows(coeff, x_m, suction_ratio_per_mps, command)
+    return float(np.mean([t.port_force_n + t.stbd_force_n for t in rows]))
 
 
 def test_the_wet_sand_resistance_loads_the_tracks_in_the_water_only():
@@ -345,3 +355,36 @@ def test_the_wet_sand_resistance_loads_the_tracks_in_the_water_only():
     # the tracks stand in ~8 cm of calm water (hulls dry); at -3 m on dry sand
     assert _soil_force_n(0.1, 1.0) > _soil_force_n(0.0, 1.0) + 50.0
     assert _soil_force_n(0.1, -3.0) == _soil_force_n(0.0, -3.0)
+
+
+def test_pore_suction_lets_the_wet_sand_carry_the_surf_load_and_is_absent_on_dry_sand():
+    # issue 13: against the surf's resistance (0.4 x W_e x wetness at x = 2 m, the tracks in
+    # ~16 cm of calm water) the paper's beach soil alone slips fully and the vehicle stalls;
+    # the saturated sand's dilatancy (suction growing with the slip velocity) carries more
+    # force at less slip, and the vehicle drives on
+    plain = _soil_rows(0.4, 2.0, 0.0, 80.0, steps=300)
+    hardened = _soil_rows(0.4, 2.0, 2.2, 80.0, steps=300)
+    assert np.mean([t.port_force_n for t in hardened]) > np.mean(
+        [t.port_force_n for t in plain]) + 50.0
+    assert np.mean([t.port_slip for t in plain]) > 0.9
+    assert np.mean([t.port_slip for t in hardened]) < 0.6
+    assert hardened[-1].x_m > plain[-1].x_m + 1.0
+    # on the dry beach nothing changes, to the bit
+    assert _soil_force_n(0.4, -3.0, 2.2) == _soil_force_n(0.4, -3.0, 0.0)
+
+
+def test_in_calm_water_the_sand_is_not_liquefied_and_offers_no_surf_resistance():
+    # the waves liquefy the sand (surf.reference_wave_height_m): calm water, no resistance
+    calm = SimCore.from_config(overrides={'surf.wet_motion_resistance_coeff': 0.4})
+    plain = SimCore.from_config(overrides={'surf.wet_motion_resistance_coeff': 0.0})
+    for sim in (calm, plain):
+        sim.reset(x_m=2.0)
+    rows = [(calm.step(Actuation(80, 80)), plain.step(Actuation(80, 80))) for _ in range(100)]
+    assert all(a.x_m == b.x_m and a.port_force_n == b.port_force_n for a, b in rows)
+
+
+def test_afloat_the_tracks_take_no_soil_force_whatever_the_suction():
+    sim = SimCore.from_config(overrides={'saturated_sand.suction_ratio_per_mps': 1e3})
+    sim.reset('afloat')
+    rows = [sim.step(Actuation(100, 100)) for _ in range(100)]
+    assert all(t.port_force_n == 0.0 and t.stbd_force_n == 0.0 for t in rows)

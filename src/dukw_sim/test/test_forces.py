@@ -9,8 +9,8 @@ import pytest
 from dukw_sim.core import SimCore
 from dukw_sim.forces import (Wrench, hydrodynamic_drag, lateral_resistance, mooring,
                              odom_force, propulsion, rolling_resistance, slope_gravity,
-                             sum_wrenches, surf_resistance, track_wetness, water_yaw_rate_rps,
-                             wave_moments)
+                             saturated_share, sum_wrenches, surf_resistance, track_wetness,
+                             water_yaw_rate_rps, wave_moments)
 from dukw_sim.world import WaterSample
 
 PARAMS = SimCore.from_config().params
@@ -136,16 +136,28 @@ def test_track_wetness_is_the_covered_share_of_the_tracks():
     assert track_wetness(np.zeros(0), 0.25) == 0.0
 
 
-def test_surf_resistance_grows_with_wetness_and_weight_within_the_tow_test_bound():
-    surf = dataclasses.replace(PARAMS.surf, wet_motion_resistance_coeff=0.2)
-    assert surf_resistance(2000.0, 0.0, (0.5, 0.5), surf, HALF_SEP_M) == []
-    half = total(surf_resistance(2000.0, 0.5, (0.5, 0.5), surf, HALF_SEP_M), 'x_n')
-    full = total(surf_resistance(2000.0, 1.0, (0.5, 0.5), surf, HALF_SEP_M), 'x_n')
+def test_saturated_share_counts_the_points_under_water():
+    assert saturated_share(np.array([-0.2, 0.0, -0.01])) == 0.0
+    assert saturated_share(np.array([0.01, -0.1, 0.3, -0.2])) == pytest.approx(0.5)
+    assert saturated_share(np.zeros(0)) == 0.0
+
+
+def test_surf_resistance_grows_with_wetness_weight_and_waves_within_the_tow_test_bound():
+    surf = dataclasses.replace(PARAMS.surf, wet_motion_resistance_coeff=0.2,
+                               reference_wave_height_m=0.28)
+    h = 0.28
+    assert surf_resistance(2000.0, 0.0, h, (0.5, 0.5), surf, HALF_SEP_M) == []
+    assert surf_resistance(2000.0, 1.0, 0.0, (0.5, 0.5), surf, HALF_SEP_M) == []   # calm
+    half = total(surf_resistance(2000.0, 0.5, h, (0.5, 0.5), surf, HALF_SEP_M), 'x_n')
+    full = total(surf_resistance(2000.0, 1.0, h, (0.5, 0.5), surf, HALF_SEP_M), 'x_n')
     assert half == pytest.approx(-200.0, rel=1e-6) and full == pytest.approx(-400.0, rel=1e-6)
-    backwards = total(surf_resistance(2000.0, 1.0, (-0.5, -0.5), surf, HALF_SEP_M), 'x_n')
+    small_waves = total(surf_resistance(2000.0, 1.0, 0.07, (0.5, 0.5), surf, HALF_SEP_M),
+                        'x_n')
+    assert small_waves == pytest.approx(-100.0, rel=1e-6)
+    backwards = total(surf_resistance(2000.0, 1.0, h, (-0.5, -0.5), surf, HALF_SEP_M), 'x_n')
     assert backwards == pytest.approx(400.0, rel=1e-6)
     heavy = dataclasses.replace(surf, wet_motion_resistance_coeff=1.0)
-    capped = total(surf_resistance(2894.0, 1.0, (0.5, 0.5), heavy, HALF_SEP_M), 'x_n')
+    capped = total(surf_resistance(2894.0, 1.0, h, (0.5, 0.5), heavy, HALF_SEP_M), 'x_n')
     assert capped == pytest.approx(-surf.max_resistance_n, rel=1e-6)
 
 

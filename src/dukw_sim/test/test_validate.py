@@ -120,3 +120,38 @@ def test_water_turns_meet_the_papers_radii(capsys):
     """One propeller stopped gives an 11-12 m circle, both at +-100 % about 2.5 m."""
     assert validate.main(['--only', 'water_turns', '--no-zigzags']) == 0
     assert capsys.readouterr().out.splitlines()[-1] == 'score: 8/8 checks ok'
+
+
+def test_surf_force_is_motor_current_times_the_gain_while_the_tracks_carry_weight():
+    """The paper's track force is motor current x 8.16 N/A (vehicle.md 3 and 6), not the soil
+    force: rows afloat, on land or without weight do not count."""
+    from dukw_sim.maneuver import ManeuverRun
+    from dukw_sim.truth import Medium
+
+    class Row:
+        def __init__(self, medium, weight_n, port_a, stbd_a):
+            self.medium, self.effective_weight_n = medium, weight_n
+            self.port_current_a, self.stbd_current_a = port_a, stbd_a
+            self.port_force_n = self.stbd_force_n = -1e6      # must not be used
+    run = ManeuverRun('transition', [Row(Medium.TRANSITION, 900.0, 30.0, 20.0),
+                                     Row(Medium.TRANSITION, 0.0, 99.0, 99.0),
+                                     Row(Medium.LAND, 2894.0, 99.0, 99.0),
+                                     Row(Medium.TRANSITION, 500.0, 10.0, 20.0)])
+    assert validate.surf_force_per_track_n(run, 8.16) == pytest.approx(8.16 * (25.0 + 15.0) / 2)
+    assert validate.track_force_gain_n_per_a(None) == 8.16
+
+
+def test_surf_transitions_meet_the_papers_force_bands(capsys):
+    """The surf's wet-sand resistance and the saturated sand's dilatancy hardening (issue 13):
+    the mean motor force per track in the 28 cm surf falls in the paper's bands at 64-100 %,
+    both ways (before: 9-41 N land-to-sea, 93-122 N sea-to-land, 0/10)."""
+    assert validate.main(['--only', 'surf_transitions', '--no-zigzags']) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == 'score: 10/10 checks ok'
+
+
+def test_without_the_surf_physics_the_surf_rows_fail(capsys):
+    """The check can fail: without the wet-sand resistance the tracks are hardly loaded."""
+    args = ['--only', 'surf_transitions', '--no-zigzags', '--set',
+            'surf.wet_motion_resistance_coeff=0']
+    assert validate.main(args) == 1
+    assert 'score: 0/10 checks ok' in capsys.readouterr().out
