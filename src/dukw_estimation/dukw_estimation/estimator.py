@@ -264,7 +264,9 @@ class Estimator:
             return slips, predicted
         body = self.vehicle.body
         ground = ground_speeds(self.ekf.x, body.hull_separation_m)
-        speeds = (tracks.port.speed_mps, tracks.stbd.speed_mps)
+        stopped = self.settings.slip_stopped_track_mps
+        speeds = [0.0 if abs(v) < stopped else v
+                  for v in (tracks.port.speed_mps, tracks.stbd.speed_mps)]
         for k in range(2):
             slips[k] = traction.slip(speeds[k], ground[k])
             predicted[k] = traction.track_force_n(speeds[k], ground[k], 0.5 * weight_n,

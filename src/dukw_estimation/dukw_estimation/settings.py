@@ -137,6 +137,10 @@ class EkfSettings:
                                       'track-force smoother: force rate noise', 1e-3, 1e5)
     force_measurement_n: float = _f('force_filter.measurement_n',
                                     'track-force smoother: current x gain noise', 1e-3, 1e4)
+    slip_stopped_track_mps: float = _f(
+        'slip.stopped_track_mps', 'a track reported slower than this counts as stopped for '
+        'its slip (its sign is the encoder noise: a spinning-up belt read as reversing gave '
+        'slip +1 against the truth -1)', 0, 1)
     # the measured track forces as a measurement of the weight on the tracks
     force_update_min_slip: float = _f('force_update.min_slip', 'both tracks slipping at least '
                                       'this much: the Wong force then tells the weight', 0, 1)
