@@ -160,6 +160,10 @@ class EkfSettings:
         'force_update.max_soil_spread', "no force update while the soil's relative force "
         'spread (soil_online) exceeds this: an unknown soil biases the surface (0: off, '
         'the configured soil trusted)', 0, 10)
+    force_update_max_slip_spread: float = _f(
+        'force_update.max_slip_spread', "no force update where the ground speed's uncertainty "
+        "moves the model's force by more than this share of it (a small slip on a soft "
+        'soil: the force then tells the slip, not the water; 0: off)', 0, 10)
     soil_preset: str = _f('soil_preset', "soil preset name; '' uses soil.*")
     # the site's soil learnt online on dry sand (soil_online.py)
     soil_online_enabled: bool = _f('soil_online.enabled', 'learn phi and k of the site from '
