@@ -419,7 +419,8 @@ def score(spec: Spec, cond: Mapping[str, Any], s: np.ndarray, mode_log: list, lo
     scored = col['t_s'] >= spec.warm_up_s
     current = np.maximum(np.abs(col['port_current_a']), np.abs(col['stbd_current_a']))
     limit_a = loop.sim.vehicle.drivetrain.continuous_current_limit_a
-    to_water, to_land = _mode_delays(col['t_s'], col['medium'], mode_log)
+    to_water, to_land = _mode_delays(col['t_s'], col['medium'], mode_log,
+                                     returns=cond['kind'] == 'mission')
     out = {
         **accuracy({name: col[name][scored] for name in ACCURACY_COLUMNS},
                    loop.sim.vehicle.body.displaced_volume_m3),
@@ -449,20 +450,24 @@ def _first(t: np.ndarray, mask: np.ndarray) -> float:
     return float(t[hits[0]]) if hits.size else math.nan
 
 
-def _mode_delays(t: np.ndarray, medium: np.ndarray, mode_log: list) -> tuple[float, float]:
+def _mode_delays(t: np.ndarray, medium: np.ndarray, mode_log: list,
+                 returns: bool = False) -> tuple[float, float]:
     """Mode WATER (LAND) minus truth WATER (LAND), first time each reaches it after the start
     in the other medium; NaN when neither happens. When only one side happens the delay
-    runs to the end of the run (a lower bound; negative: the mode changed, the truth not)."""
+    runs to the end of the run (a lower bound; negative: the mode changed, the truth not).
+    ``returns`` (a mission: land, sea, land): starting in the target medium, the delay of
+    the return to it, counted from the truth's first time in the other one."""
     if not t.size:
         return math.nan, math.nan
     end = float(t[-1])
     out = []
     for target in (2, 0):                    # WATER, LAND (Medium and Mode share values)
-        if medium[0] == target:
+        since = _first(t, medium == 2 - target) if medium[0] == target else -math.inf
+        if math.isnan(since) or (medium[0] == target and not returns):
             out.append(math.nan)
             continue
-        truth_t = _first(t, medium == target)
-        modes = [when for when, mode, _ in mode_log if int(mode) == target]
+        truth_t = _first(t, (medium == target) & (t >= since))
+        modes = [when for when, mode, _ in mode_log if int(mode) == target and when >= since]
         mode_t = modes[0] if modes else math.nan
         if math.isnan(truth_t) and math.isnan(mode_t):
             out.append(math.nan)

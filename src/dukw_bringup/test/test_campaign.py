@@ -7,6 +7,7 @@ import csv
 import json
 import math
 
+import numpy as np
 import pytest
 import yaml
 
@@ -310,3 +311,14 @@ def test_a_mission_spec_with_a_bad_mission_is_refused(tmp_path):
                                  mission={'file': str(tmp_path / 'missing.yaml')}))
     with pytest.raises(campaign.SpecError, match='mission.waypoints'):
         campaign.parse_spec(dict(SPEC, kinds=['mission'], mission={'waypoints': 'two'}))
+
+
+def test_a_missions_return_to_land_is_timed_from_its_time_at_sea():
+    """Land, sea, land: the delay to LAND is the return's (a transition run starting on land
+    has none)."""
+    t = np.arange(10.0)
+    medium = np.array([0, 0, 1, 2, 2, 2, 1, 0, 0, 0])
+    modes = [(0.0, 0, ''), (1.5, 1, ''), (3.5, 2, ''), (6.0, 1, ''), (7.8, 0, '')]
+    assert campaign._mode_delays(t, medium, modes, returns=True) == pytest.approx((0.5, 0.8))
+    to_water, to_land = campaign._mode_delays(t, medium, modes)
+    assert to_water == pytest.approx(0.5) and math.isnan(to_land)
