@@ -9,6 +9,13 @@ Model mismatch: the simulator's beach slope, soil and sea are the drawn ones, wh
 estimator keeps the configured vehicle, beach and soil (``estimator_knows_site=False``).
 A spec's ``oracle_site: true`` is the diagnostic counterpart: the estimator is handed the
 drawn slope and soil, so what is left of the misses is not due to the mismatch.
+
+The ``mission`` kind flies a mission file (``dukw_bringup.mission``, as mission_node does:
+line-of-sight guidance on the EKF's odometry at mission_node's rate, started
+``start_delay_s`` after the first odometry) from the mission's start pose (plus the drawn
+start offset along x) through the drawn beach and sea; the run ends when the mission does
+(or after ``duration_s``). Its row adds ``mission_done`` and ``mission_time_s``; a mission
+not done misses the target ``mission_done``.
 """
 from __future__ import annotations
 
@@ -24,10 +31,11 @@ import numpy as np
 import yaml
 
 from dukw_bringup.accuracy import ACCURACY_COLUMNS, accuracy
-from dukw_common.config import node_params
+from dukw_bringup.mission import LosGuidance, MissionSpec, MissionState, load_mission
+from dukw_common.config import ConfigError, node_params
 from dukw_common.geometry import geodetic_from_local_enu
 
-KINDS = ('land_to_sea', 'sea_to_land', 'land_circle', 'water_circle')
+KINDS = ('land_to_sea', 'sea_to_land', 'land_circle', 'water_circle', 'mission')
 #: Drawn per run, in this order (the order is part of reproducibility: never reorder).
 DRAWS = ('kind', 'significant_wave_height_m', 'peak_period_s', 'spreading_rad',
          'beach_slope_deg', 'soil_preset', 'cohesion_kpa', 'friction_angle_deg',
@@ -67,6 +75,7 @@ class Spec:
     targets: Mapping[str, float]
     sim_overrides: Mapping[str, Any]
     oracle_site: bool = False
+    mission: MissionSpec | None = None     # the mission kind's mission (loaded, cut)
 
 
 def load_spec(path: str) -> Spec:
@@ -86,7 +95,7 @@ def parse_spec(raw: Any) -> Spec:
     if not isinstance(raw, dict):
         raise SpecError('campaign spec must be a mapping')
     known = {'name', 'seed', 'runs', 'duration_s', 'warm_up_s', 'kinds', 'draws', 'faults',
-             'targets', 'sim_overrides', 'oracle_site'}
+             'targets', 'sim_overrides', 'oracle_site', 'mission'}
     _no_unknown(raw, known, 'spec')
     seed = _int(raw, 'seed', 0, 2 ** 63 - 1)
     runs = _int(raw, 'runs', 1, 10_000_000)
@@ -117,9 +126,33 @@ def parse_spec(raw: Any) -> Spec:
     oracle = raw.get('oracle_site', False)
     if not isinstance(oracle, bool):
         raise SpecError(f'oracle_site must be true or false, got {oracle!r}')
+    mission = _mission(raw.get('mission', {}), 'mission' in kinds)
     return Spec(str(raw.get('name', 'campaign')), seed, runs, duration, warm_up, tuple(kinds),
                 checked, faults, {k: float(targets[k]) for k in TARGET_NAMES}, dict(overrides),
-                oracle)
+                oracle, mission)
+
+
+def _mission(raw: Any, needed: bool) -> MissionSpec | None:
+    """``mission: {file: PATH ('' or absent: config/mission.yaml), waypoints: N (the first
+    N only; absent: all)}``, loaded here so the workers need not read it."""
+    if not isinstance(raw, dict):
+        raise SpecError('mission must be a mapping {file: PATH, waypoints: N}')
+    _no_unknown(raw, {'file', 'waypoints'}, 'mission')
+    if not needed:
+        return None
+    path = raw.get('file', '') or None
+    if path is not None and not isinstance(path, str):
+        raise SpecError(f'mission.file must be a path, got {path!r}')
+    try:
+        spec = load_mission(path)
+        if 'waypoints' in raw:
+            count = raw['waypoints']
+            if isinstance(count, bool) or not isinstance(count, int):
+                raise SpecError(f'mission.waypoints must be an integer, got {count!r}')
+            spec = spec.with_waypoints(count)
+    except ConfigError as exc:
+        raise SpecError(f'mission: {exc}') from exc
+    return spec
 
 
 def _no_unknown(section: Mapping, known: set, where: str) -> None:
@@ -308,6 +341,11 @@ def build_loop(spec: Spec, cond: Mapping[str, Any]):
         loop.est.set_soil(loop.sim.vehicle.soil)
     loop.sensors.seed = cond['sensor_seed']
     loop.sensors.reset()
+    if cond['kind'] == 'mission':
+        start = spec.mission.start
+        loop.truth = loop.sim.reset('sand' if start.x_m < 0.0 else 'afloat',
+                                    start.x_m + cond['start_offset_m'], start.yaw_rad)
+        return loop
     start, yaw = {'land_to_sea': ('sand', 0.0), 'land_circle': ('flat', 0.0),
                   'water_circle': ('afloat', 0.0)}.get(cond['kind'], ('sea', math.pi))
     x_m = loop.sim.start_x_m(start) + cond['start_offset_m']     # (the slope: site.*, above)
@@ -315,13 +353,50 @@ def build_loop(spec: Spec, cond: Mapping[str, Any]):
     return loop
 
 
+class MissionPilot:
+    """mission_node's behaviour in the loop: guidance on the EKF's odometry at ``rate_hz``,
+    started ``start_delay_s`` after the first odometry; zero velocity before."""
+
+    def __init__(self, mission: MissionSpec, rate_hz: float) -> None:
+        self.guidance = LosGuidance(mission)
+        self.period_s = 1.0 / rate_hz
+        self.next_s = 0.0
+        self.first_pose_s: float | None = None
+
+    @property
+    def state(self) -> MissionState:
+        return self.guidance.progress.state
+
+    def command(self, t_s: float, estimate) -> tuple[float, float] | None:
+        """The cmd_vel due at ``t_s`` (None between the node's ticks)."""
+        if t_s < self.next_s - 1e-9:
+            return None
+        self.next_s = t_s + self.period_s
+        if estimate is None:
+            return (0.0, 0.0)
+        odo = estimate.odometry
+        if self.first_pose_s is None:
+            self.first_pose_s = t_s
+        if self.state is MissionState.WAITING and \
+                t_s - self.first_pose_s >= self.guidance.spec.start_delay_s:
+            self.guidance.start(t_s, odo.x_m, odo.y_m)
+        out = self.guidance.update(t_s, odo.x_m, odo.y_m, odo.yaw_rad)
+        return (out.speed_mps, out.yaw_rate_rps)
+
+
 def simulate(spec: Spec, cond: Mapping[str, Any]) -> tuple[np.ndarray, list, Any]:
     """Run the stack; the per-step series (SERIES_COLUMNS) and the mode changes."""
     loop = build_loop(spec, cond)
     cmd = (cond['speed_mps'], cond['yaw_rate_rps'])
+    pilot = loop.pilot = MissionPilot(spec.mission, float(node_params('mission_node')[
+        'rate_hz'])) if cond['kind'] == 'mission' else None
     rows = []
     for _ in range(int(round(spec.duration_s / loop.sim.dt_s))):
         before = loop.truth
+        if pilot is not None:
+            if pilot.state.finished:
+                break
+            cmd = pilot.command(before.t_s, loop.estimate)
         loop.step(cmd)
         if loop.estimate is None:
             continue
@@ -344,7 +419,8 @@ def score(spec: Spec, cond: Mapping[str, Any], s: np.ndarray, mode_log: list, lo
     scored = col['t_s'] >= spec.warm_up_s
     current = np.maximum(np.abs(col['port_current_a']), np.abs(col['stbd_current_a']))
     limit_a = loop.sim.vehicle.drivetrain.continuous_current_limit_a
-    to_water, to_land = _mode_delays(col['t_s'], col['medium'], mode_log)
+    to_water, to_land = _mode_delays(col['t_s'], col['medium'], mode_log,
+                                     returns=cond['kind'] == 'mission')
     out = {
         **accuracy({name: col[name][scored] for name in ACCURACY_COLUMNS},
                    loop.sim.vehicle.body.displaced_volume_m3),
@@ -357,6 +433,11 @@ def score(spec: Spec, cond: Mapping[str, Any], s: np.ndarray, mode_log: list, lo
         'end_medium': int(col['medium'][-1]) if len(s) else -1,
         'end_mode': int(col['mode'][-1]) if len(s) else -1,
     }
+    pilot = getattr(loop, 'pilot', None)
+    if pilot is not None:
+        done = pilot.state is MissionState.DONE
+        out['mission_done'] = done
+        out['mission_time_s'] = pilot.guidance.progress.elapsed_s if done else math.nan
     out = {k: (round(v, 6) if isinstance(v, float) else v) for k, v in out.items()}
     failed = failed_targets(out, spec.targets)
     out['targets_met'] = not failed
@@ -369,20 +450,24 @@ def _first(t: np.ndarray, mask: np.ndarray) -> float:
     return float(t[hits[0]]) if hits.size else math.nan
 
 
-def _mode_delays(t: np.ndarray, medium: np.ndarray, mode_log: list) -> tuple[float, float]:
+def _mode_delays(t: np.ndarray, medium: np.ndarray, mode_log: list,
+                 returns: bool = False) -> tuple[float, float]:
     """Mode WATER (LAND) minus truth WATER (LAND), first time each reaches it after the start
     in the other medium; NaN when neither happens. When only one side happens the delay
-    runs to the end of the run (a lower bound; negative: the mode changed, the truth not)."""
+    runs to the end of the run (a lower bound; negative: the mode changed, the truth not).
+    ``returns`` (a mission: land, sea, land): starting in the target medium, the delay of
+    the return to it, counted from the truth's first time in the other one."""
     if not t.size:
         return math.nan, math.nan
     end = float(t[-1])
     out = []
     for target in (2, 0):                    # WATER, LAND (Medium and Mode share values)
-        if medium[0] == target:
+        since = _first(t, medium == 2 - target) if medium[0] == target else -math.inf
+        if math.isnan(since) or (medium[0] == target and not returns):
             out.append(math.nan)
             continue
-        truth_t = _first(t, medium == target)
-        modes = [when for when, mode, _ in mode_log if int(mode) == target]
+        truth_t = _first(t, (medium == target) & (t >= since))
+        modes = [when for when, mode, _ in mode_log if int(mode) == target and when >= since]
         mode_t = modes[0] if modes else math.nan
         if math.isnan(truth_t) and math.isnan(mode_t):
             out.append(math.nan)
@@ -410,6 +495,8 @@ def failed_targets(metrics: Mapping[str, Any], targets: Mapping[str, float]) -> 
     for name in ('mode_delay_to_water_s', 'mode_delay_to_land_s'):
         if not math.isnan(metrics[name]) and abs(metrics[name]) > targets['mode_delay_s']:
             out.append(name)
+    if metrics.get('mission_done') is False:
+        out.append('mission_done')
     return out
 
 

@@ -21,7 +21,7 @@ from dukw_bringup.campaign import SERIES_COLUMNS, Spec
 
 METRICS = ('position_rmse_m', 'heading_rmse_deg', 'slip_rmse', 'volume_error_pct',
            'fraction_error', 'mode_delay_to_water_s', 'mode_delay_to_land_s', 'chatter_count',
-           'time_over_limit_s', 'peak_current_a', 'wall_s')
+           'time_over_limit_s', 'peak_current_a', 'wall_s', 'mission_time_s')
 CONDITIONS = ('significant_wave_height_m', 'peak_period_s', 'beach_slope_deg', 'cohesion_kpa',
               'friction_angle_deg', 'shear_modulus_cm', 'speed_mps')
 PERCENTILES = (5, 50, 95, 100)
@@ -79,6 +79,8 @@ def summarize(spec: Spec, rows: Sequence[Mapping[str, Any]]) -> dict:
         'share_meeting_targets': round((len(done) - len(missed)) / total, 4) if total else 0.0,
         'missed_per_target': dict(sorted(per_target.items())),
         'by_kind': _by_kind(done),
+        **({'missions_done': sum(r['mission_done'] is True for r in done)}
+           if any('mission_done' in r for r in done) else {}),
         'conditions_meeting_vs_missing': _conditions_split(done),
         'percentiles': percentiles,
         'wall_s_per_run_mean': round(float(np.mean(_values(rows, 'wall_s'))), 3) if rows else 0,

@@ -7,6 +7,7 @@ import csv
 import json
 import math
 
+import numpy as np
 import pytest
 import yaml
 
@@ -250,3 +251,74 @@ def test_a_run_on_dry_sand_learns_the_drawn_soil_online():
     assert abs(force(loop.est.soil) - force(site)) < 0.35 * abs(force(prior) - force(site))
     assert loop.est.contact.soil == online.soil             # the contact model uses it
 
+
+
+MISSION = {'mission': {
+    'name': 'short', 'start': {'x_m': -4.0, 'yaw_rad': 0.0},
+    'sea': {'significant_height_m': 0.0, 'peak_period_s': 4.0, 'seed': 0},
+    'start_delay_s': 0.5, 'timeout_s': 12.0, 'acceptance_radius_m': 1.0, 'lookahead_m': 3.0,
+    'heading_gain_per_s': 0.8, 'max_yaw_rate_rps': 0.35, 'min_speed_fraction': 0.3,
+    'waypoints': [{'name': 'down', 'x_m': -1.5, 'y_m': 0.0, 'speed_mps': 1.0},
+                  {'name': 'far', 'x_m': 40.0, 'y_m': 0.0, 'speed_mps': 1.0}]}}
+
+
+def test_a_mission_campaign_flies_the_mission_and_is_reproducible(tmp_path):
+    """Two short missions (the first waypoint 2.5 m down the dry beach) on 2 workers: done,
+    with their time and currents; the same metrics again when each run is repeated here."""
+    mission_file = tmp_path / 'mission.yaml'
+    mission_file.write_text(yaml.safe_dump(MISSION), encoding='utf-8')
+    raw = dict(SPEC, name='missions', runs=2, duration_s=10.0, kinds=['mission'],
+               mission={'file': str(mission_file), 'waypoints': 1}, sim_overrides={},
+               faults={})
+    out = tmp_path / 'out'
+    assert campaign_cli.main([_write_spec(tmp_path / 's.yaml', raw), '--workers', '2',
+                              '--out', str(out), '--no-progress']) == 0
+    rows = _rows(out)
+    assert [r['kind'] for r in rows] == ['mission', 'mission'] and not any(
+        r['error'] for r in rows)
+    for row in rows:
+        assert row['mission_done'] == 'True'
+        assert 0.5 < float(row['mission_time_s']) < 9.0     # 2.5 m at about 1 m/s
+        assert float(row['end_x_m']) > -3.0                   # it drove there
+        assert float(row['peak_current_a']) > 0.0 and float(row['time_over_limit_s']) >= 0.0
+    summary = json.loads((out / 'summary.json').read_text())
+    assert summary['missions_done'] == 2
+    spec = campaign.parse_spec(raw)
+    for row in rows:
+        again = campaign.run_one(spec, int(row['index']))
+        for key, value in row.items():
+            if key not in NOT_COMPARED | {'error'}:
+                got = again[key]
+                assert (value == 'nan') if isinstance(got, float) and math.isnan(got) \
+                    else str(got) == value, key
+
+
+def test_a_mission_not_done_misses_its_target(tmp_path):
+    """The second waypoint is 40 m away: not reached in 4 s, so the run misses the target."""
+    mission_file = tmp_path / 'mission.yaml'
+    mission_file.write_text(yaml.safe_dump(MISSION), encoding='utf-8')
+    spec = campaign.parse_spec(dict(SPEC, runs=1, duration_s=4.0, kinds=['mission'],
+                                    mission={'file': str(mission_file)}, sim_overrides={}))
+    row = campaign.run_one(spec, 0)
+    assert row['error'] == '' and row['mission_done'] is False
+    assert math.isnan(row['mission_time_s']) and 'mission_done' in row['failed_targets']
+    assert not row['targets_met']
+
+
+def test_a_mission_spec_with_a_bad_mission_is_refused(tmp_path):
+    with pytest.raises(campaign.SpecError, match='mission'):
+        campaign.parse_spec(dict(SPEC, kinds=['mission'],
+                                 mission={'file': str(tmp_path / 'missing.yaml')}))
+    with pytest.raises(campaign.SpecError, match='mission.waypoints'):
+        campaign.parse_spec(dict(SPEC, kinds=['mission'], mission={'waypoints': 'two'}))
+
+
+def test_a_missions_return_to_land_is_timed_from_its_time_at_sea():
+    """Land, sea, land: the delay to LAND is the return's (a transition run starting on land
+    has none)."""
+    t = np.arange(10.0)
+    medium = np.array([0, 0, 1, 2, 2, 2, 1, 0, 0, 0])
+    modes = [(0.0, 0, ''), (1.5, 1, ''), (3.5, 2, ''), (6.0, 1, ''), (7.8, 0, '')]
+    assert campaign._mode_delays(t, medium, modes, returns=True) == pytest.approx((0.5, 0.8))
+    to_water, to_land = campaign._mode_delays(t, medium, modes)
+    assert to_water == pytest.approx(0.5) and math.isnan(to_land)

@@ -264,7 +264,9 @@ class Estimator:
             return slips, predicted
         body = self.vehicle.body
         ground = ground_speeds(self.ekf.x, body.hull_separation_m)
-        speeds = (tracks.port.speed_mps, tracks.stbd.speed_mps)
+        stopped = self.settings.slip_stopped_track_mps
+        speeds = [0.0 if abs(v) < stopped else v
+                  for v in (tracks.port.speed_mps, tracks.stbd.speed_mps)]
         x = self.ekf.x
         saturation = self.contact.saturation(
             x[Idx.S], x[Idx.ETA], math.cos(x[Idx.YAW] - self.settings.seaward_yaw_rad))

@@ -137,6 +137,10 @@ class EkfSettings:
                                       'track-force smoother: force rate noise', 1e-3, 1e5)
     force_measurement_n: float = _f('force_filter.measurement_n',
                                     'track-force smoother: current x gain noise', 1e-3, 1e4)
+    slip_stopped_track_mps: float = _f(
+        'slip.stopped_track_mps', 'a track reported slower than this counts as stopped for '
+        'its slip (its sign is the encoder noise: a spinning-up belt read as reversing gave '
+        'slip +1 against the truth -1)', 0, 1)
     # the measured track forces as a measurement of the weight on the tracks
     force_update_min_slip: float = _f('force_update.min_slip', 'both tracks slipping at least '
                                       'this much: the Wong force then tells the weight', 0, 1)
@@ -156,6 +160,10 @@ class EkfSettings:
         'force_update.max_soil_spread', "no force update while the soil's relative force "
         'spread (soil_online) exceeds this: an unknown soil biases the surface (0: off, '
         'the configured soil trusted)', 0, 10)
+    force_update_max_slip_spread: float = _f(
+        'force_update.max_slip_spread', "no force update where the ground speed's uncertainty "
+        "moves the model's force by more than this share of it (a small slip on a soft "
+        'soil: the force then tells the slip, not the water; 0: off)', 0, 10)
     soil_preset: str = _f('soil_preset', "soil preset name; '' uses soil.*")
     # the site's soil learnt online on dry sand (soil_online.py)
     soil_online_enabled: bool = _f('soil_online.enabled', 'learn phi and k of the site from '

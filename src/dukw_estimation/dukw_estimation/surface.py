@@ -147,6 +147,10 @@ class SurfaceObserver:
                    - predicted) / GROUND_STEP_MPS
         ground_var = P[Idx.U, Idx.U] + lever * lever * P[Idx.R, Idx.R] \
             + 2.0 * lever * P[Idx.U, Idx.R]
+        if st.force_update_max_slip_spread > 0.0 and abs(per_mps) * math.sqrt(
+                max(ground_var, 0.0)) > st.force_update_max_slip_spread * max(
+                abs(predicted), abs(measured_n), 1.0):
+            return                       # the force says more about the slip than the surface
         h = np.zeros(N_STATES)
         h[Idx.ETA] = per_m
         h[Idx.S] = per_m * sin_t         # the volume follows the water depth eta + s sin

@@ -116,6 +116,18 @@ def test_slip_per_track_from_the_ground_speed_at_that_track():
     assert est2.traction().port_slip == pytest.approx(-0.25, abs=0.05)
 
 
+def test_a_stopped_track_read_slightly_reversed_slips_as_a_stopped_one():
+    """A belt spinning up from rest reads -0.01 m/s in its encoder noise: with the vehicle
+    moving on at 1 m/s its slip is a stopped track's -1, not the +1 of a reversing belt."""
+    for stopped_mps, expected in ((0.03, -1.0), (0.0, 1.0)):
+        est = make(slip_stopped_track_mps=stopped_mps)
+        Drive(est, u=1.0, r=0.0).run(5.0, track_speed=(-0.01, -0.01))
+        assert (est.traction().port_slip, est.traction().stbd_slip) == (expected, expected)
+    est = make()
+    Drive(est, u=1.0, r=0.0).run(5.0, track_speed=(-0.5, -0.5))       # a reversing belt
+    assert est.traction().port_slip == 1.0
+
+
 def test_on_dry_land_all_weight_on_tracks_and_force_prediction_matches_the_model():
     est = make()
     Drive(est).run(10.0)
@@ -354,6 +366,22 @@ def test_track_forces_are_not_used_at_low_slip():
     _surf_run(deaf, -0.06, 0.02)
     assert quiet.traction().weight_on_tracks_fraction == pytest.approx(
         deaf.traction().weight_on_tracks_fraction, abs=1e-9)
+
+
+def test_track_forces_whose_slip_is_too_uncertain_are_not_used():
+    """force_update.max_slip_spread: where the ground speed's uncertainty moves the model's
+    force by more than that share, the force tells the slip rather than the water."""
+    def fraction(**changes):
+        est = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, soil_online_enabled=False,
+                   **changes)
+        _surf_run(est, -0.06, 0.4)
+        return est.traction().weight_on_tracks_fraction
+    deaf, used = fraction(force_update_sigma_n=0.0), fraction(force_update_max_slip_spread=0.0)
+    assert abs(used - deaf) > 0.1
+    # slipping 0.4, the ground speed's error hardly moves the force: used as without the gate
+    assert fraction(force_update_max_slip_spread=0.2) == pytest.approx(used, abs=1e-9)
+    # a gate tighter than any force's spread keeps most of them out
+    assert abs(fraction(force_update_max_slip_spread=1e-4) - deaf) < 0.3 * abs(used - deaf)
 
 
 def test_track_forces_of_nearly_stopped_tracks_are_not_used():
