@@ -380,8 +380,9 @@ def test_track_forces_whose_slip_is_too_uncertain_are_not_used():
     assert abs(used - deaf) > 0.1
     # slipping 0.4, the ground speed's error hardly moves the force: used as without the gate
     assert fraction(force_update_max_slip_spread=0.2) == pytest.approx(used, abs=1e-9)
-    # a gate tighter than any force's spread keeps most of them out
-    assert abs(fraction(force_update_max_slip_spread=1e-4) - deaf) < 0.3 * abs(used - deaf)
+    # a gate tighter than any force's spread keeps most of them out (0.32 of the forces' pull
+    # gets through since the saturated sand's suction, issue 13; 0.3 was the bound before)
+    assert abs(fraction(force_update_max_slip_spread=1e-4) - deaf) < 0.5 * abs(used - deaf)
 
 
 def test_track_forces_of_nearly_stopped_tracks_are_not_used():
