@@ -487,7 +487,7 @@ class SimCore:
                   if limited[i] else self._loaded_speed(i, new[i] + others[i], loop_k[i])
                   for i in range(2)]
         self.track_speed = speeds
-        slips = traction.slip(np.array(speeds), np.array(ground_new)).tolist()
+        slips = [traction.slip_f(speeds[i], ground_new[i]) for i in range(2)]
         c, s = yaw_cs
         self.yaw = (self.yaw + dt * self.r + math.pi) % (2.0 * math.pi) - math.pi
         self.x += dt * (c * self.u - s * self.v)
