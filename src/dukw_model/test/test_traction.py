@@ -196,8 +196,9 @@ def test_float_path_gives_the_array_path_bits(weight_n, saturation, soil):
     want = traction.track_force_n(speeds, grounds, weight_n, soil, A / 2, L, suction,
                                   saturation)
     patch = traction.TrackPatch(weight_n, soil, A / 2, L, suction, saturation)
-    got = [traction.track_force_f(patch, float(v), float(g)) for v, g in zip(speeds, grounds)]
+    pairs = list(zip(speeds.tolist(), grounds.tolist(), strict=True))
+    got = [traction.track_force_f(patch, v, g) for v, g in pairs]
     assert _bits(got) == _bits(want)
-    slips = [traction.slip_f(float(v), float(g)) for v, g in zip(speeds, grounds)]
+    slips = [traction.slip_f(v, g) for v, g in pairs]
     assert _bits(slips) == _bits(traction.slip(speeds, grounds))
     assert patch.strength_n(450.0) == traction.max_traction_n(weight_n, soil, A / 2, 450.0)
