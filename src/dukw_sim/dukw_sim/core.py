@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Mapping
+from typing import Mapping, NamedTuple
 
 import numpy as np
 
@@ -49,8 +49,7 @@ _NEWTON_PASSES = 3             # implicit track-soil solve
 _NEWTON_TOL_MPS = 2e-4
 
 
-@dataclass(frozen=True)
-class TrackState:
+class TrackState(NamedTuple):
     """Both tracks after a step (port, starboard): speed, soil force, motor force, slip."""
 
     track_speed_mps: list
@@ -59,8 +58,7 @@ class TrackState:
     slip: list
 
 
-@dataclass(frozen=True)
-class _Drives:
+class _Drives(NamedTuple):
     """The track drives during a step, before the soil forces are solved for."""
 
     ground: tuple                # speed of the ground under each track, m/s (body surge)
@@ -71,9 +69,8 @@ class _Drives:
     lin: TrackLinear             # the soil forces linearised at the step's ground speeds
 
 
-@dataclass(frozen=True)
-class _Stepped:
-    """What a step leaves for the Truth beyond the state."""
+class _Stepped(NamedTuple):
+    """What a step leaves for the Truth beyond the state (NamedTuples: made every step)."""
 
     tracks: TrackState
     thrust_n: list
@@ -182,6 +179,10 @@ class SimCore:
         self._external = (0.0, 0.0, 0.0)
         self._hydro_key = None
         self._hydro_val = None
+        self._ground_key = None
+        self._ground_val = None
+        # the strips' squared distance from the centre of gravity (water yaw rate's weights)
+        self._station_r2 = self.hull.station_x_m ** 2 + self.hull.station_y_m ** 2
         self._wave_a2 = float(np.sum(self.world.waves.amplitude_m ** 2))
         self.reset()
 
@@ -252,7 +253,17 @@ class SimCore:
         self._external = (float(fx_n), float(fy_n), float(yaw_moment_nm))
 
     def _ground_pose(self) -> tuple[float, float, float, float]:
-        """Ground height at base_link, pitch and roll of a vehicle resting on it, slope."""
+        """Ground height at base_link, pitch and roll of a vehicle resting on it, slope
+        (remembered for the last position and heading: a step asks at its end and the next
+        one at its start)."""
+        key = (self.x, self.yaw)
+        if key == self._ground_key:
+            return self._ground_val
+        self._ground_val = self._ground_pose_at()
+        self._ground_key = key
+        return self._ground_val
+
+    def _ground_pose_at(self) -> tuple[float, float, float, float]:
         beach = self.world.beach
         c, s = math.cos(self.yaw), math.sin(self.yaw)
         half = self._track_len / 2.0
@@ -378,7 +389,8 @@ class SimCore:
         p, drive = self.params, self.vehicle.drivetrain
         targets = self._advance_speed_refs(act)
         ground = (self.u - self.r * self._half_sep, self.u + self.r * self._half_sep)
-        track_imm = min(max(float(depths.mean()) / self.seakeeping.equilibrium_depth_m, 0.0), 1.0)
+        mean_depth = float(depths.sum()) / depths.size         # depths.mean(), same bits
+        track_imm = min(max(mean_depth / self.seakeeping.equilibrium_depth_m, 0.0), 1.0)
         others = []
         paddle = []
         for i in range(2):
@@ -433,7 +445,7 @@ class SimCore:
         if not self.params.wave_moments.strip_moments or self.world.calm:
             return 0.0
         return water_yaw_rate_rps(areas, water, self.hull.station_x_m, self.hull.station_y_m,
-                                  yaw_cs)
+                                  yaw_cs, self._station_r2)
 
     def _water_over_tracks(self) -> np.ndarray:
         """Height of the surface over the sand at the strips along the tracks' contact, m."""
