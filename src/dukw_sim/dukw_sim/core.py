@@ -181,6 +181,8 @@ class SimCore:
         self._hydro_val = None
         self._ground_key = None
         self._ground_val = None
+        self._over_tracks_of = None
+        self._over_tracks = None
         # the strips' squared distance from the centre of gravity (water yaw rate's weights)
         self._station_r2 = self.hull.station_x_m ** 2 + self.hull.station_y_m ** 2
         self._wave_a2 = float(np.sum(self.world.waves.amplitude_m ** 2))
@@ -449,9 +451,14 @@ class SimCore:
 
     def _water_over_tracks(self) -> np.ndarray:
         """Height of the surface over the sand at the strips along the tracks' contact, m."""
-        px, water = self._hydro()[:2]
-        n = self._n_stations
-        return (water.elevation_m[:n] - self.world.beach.heights_m(px[:n]))[self._track_strips]
+        hydro = self._hydro()
+        if self._over_tracks_of is not hydro:      # once per pose: contact, then resistance
+            px, water = hydro[:2]
+            n = self._n_stations
+            self._over_tracks = (water.elevation_m[:n]
+                                 - self.world.beach.heights_m(px[:n]))[self._track_strips]
+            self._over_tracks_of = hydro
+        return self._over_tracks
 
     def _track_wetness(self) -> float:
         """Share of the tracks' height under the surface (over the contact length), 0..1."""

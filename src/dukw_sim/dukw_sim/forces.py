@@ -23,6 +23,8 @@ _ROLL_EPS_MPS = 0.005          # regularisation of Coulomb rolling resistance
 _FRICTION_EPS_MPS = 0.02       # of drivetrain friction
 _BREAKAWAY_MPS = 0.05          # below this track speed the breakaway friction applies
 LATERAL_POINTS = 5             # points along each track for the lateral resistance
+# np.clip's ufunc without its Python wrappers (np.clip of floats calls it; same bits)
+_clip = getattr(getattr(np, '_core', None), 'umath', np).clip
 
 
 class Wrench(NamedTuple):
@@ -177,7 +179,8 @@ def track_wetness(water_over_ground_m: np.ndarray, track_height_m: float) -> flo
     mean of the given points along the tracks."""
     if water_over_ground_m.size == 0:
         return 0.0
-    return float(np.mean(np.clip(water_over_ground_m / track_height_m, 0.0, 1.0)))
+    share = _clip(water_over_ground_m / track_height_m, 0.0, 1.0)
+    return float(share.sum()) / share.size                     # np.mean, same bits
 
 
 def saturated_share(water_over_ground_m: np.ndarray) -> float:

@@ -75,7 +75,8 @@ def _compliant_speeds(patch: traction.TrackPatch, strength: float, ref: list, gr
     h(v) = F_soil(v, g) + others - k (ref - v) rises with v; safeguarded Newton inside the
     bracket the soil's strength S gives: v in [ref - (S + o)/k, ref + (S - o)/k]. Both tracks
     step together until both have converged; in floats (numpy on two tracks costs more than
-    the physics), the same bits as the vectorised form.
+    the physics), the same bits as the vectorised form. Returns the speeds and, when they
+    converged, the soil forces there (else None).
     """
     force = traction.track_force_f
     lo = [ref[i] - (strength + others[i]) / stiffness[i] for i in range(2)]
@@ -85,7 +86,7 @@ def _compliant_speeds(patch: traction.TrackPatch, strength: float, ref: list, gr
         f = [force(patch, v[0], ground[0]), force(patch, v[1], ground[1])]
         h = [f[i] + others[i] - stiffness[i] * (ref[i] - v[i]) for i in range(2)]
         if abs(h[0]) < _COMPLIANCE_TOL_N and abs(h[1]) < _COMPLIANCE_TOL_N:
-            break
+            return v, f
         for i in range(2):
             if h[i] > 0.0:
                 hi[i] = v[i]
@@ -95,7 +96,7 @@ def _compliant_speeds(patch: traction.TrackPatch, strength: float, ref: list, gr
                 + stiffness[i]
             step = v[i] - h[i] / slope
             v[i] = step if lo[i] < step < hi[i] else 0.5 * (lo[i] + hi[i])
-    return v
+    return v, None
 
 
 def linearise(contact: TrackContact | None, ref_mps: tuple, ground_mps: tuple,
@@ -115,15 +116,20 @@ def linearise(contact: TrackContact | None, ref_mps: tuple, ground_mps: tuple,
     stiff = [float(k) for k in stiffness_n_per_mps]
     soft = [math.isfinite(k) for k in stiff]
     patch = contact.patch
+    force = traction.track_force_f
     speed = ref
+    f0 = None
     if soft[0] or soft[1]:
         guess = ref if guess_mps is None else [float(g) for g in guess_mps]
         k_soft = [stiff[i] if soft[i] else 1.0 for i in range(2)]
-        loaded = _compliant_speeds(patch, contact.strength_n(slipping=True), ref, ground,
-                                   [float(o) for o in others_n], k_soft, guess)
+        loaded, f_loaded = _compliant_speeds(patch, contact.strength_n(slipping=True), ref,
+                                             ground, [float(o) for o in others_n], k_soft,
+                                             guess)
         speed = [loaded[i] if soft[i] else ref[i] for i in range(2)]
-    force = traction.track_force_f
-    f0 = [force(patch, speed[i], ground[i]) for i in range(2)]
+        if f_loaded is not None and soft[0] and soft[1]:
+            f0 = f_loaded                           # the forces at the converged speeds
+    if f0 is None:
+        f0 = [force(patch, speed[i], ground[i]) for i in range(2)]
     d_g = [(force(patch, speed[i], ground[i] + _PROBE_MPS) - f0[i]) / _PROBE_MPS
            for i in range(2)]
     d_t = [(force(patch, speed[i] + _PROBE_MPS, ground[i]) - f0[i]) / _PROBE_MPS
