@@ -282,6 +282,8 @@ class World:
         self._wavenumbers[3] = -0.5 * math.pi
         self._time_key: float | None = None
         self._transfer_key: tuple[float, float] | None = None
+        self._sinh_depth: float | None = None
+        self._sinh_kd = np.zeros(0)
         self._points = np.zeros((0, 4))
         self._points_key = (0, 0)
         self._still_x = np.array([beach.flat_start_x_m, beach.sea_floor_x_m])
@@ -383,8 +385,11 @@ class World:
         zc = min(max(kin_height_m, -depth), 0.0)
         if (zc, depth) == self._transfer_key:     # e.g. the hull above the water
             return
+        if depth != self._sinh_depth:             # e.g. off the slope: the sea floor's depth
+            self._sinh_kd = np.sinh(self._k * depth)
+            self._sinh_depth = depth
         transfer = np.cosh(self._k * (zc + depth))
-        transfer /= np.sinh(self._k * depth)
+        transfer /= self._sinh_kd
         np.multiply(transfer[:, None], self._kin_weights, out=self._weights[:, 1:])
         self._transfer_key = (zc, depth)
 
