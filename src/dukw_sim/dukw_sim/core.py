@@ -407,7 +407,8 @@ class SimCore:
             others.append(fric + pad)
         contact = self._track_contact(w_eff)
         # the speed loops give under load; at a zero command they hold the track (brake)
-        loop_k = tuple(self._loop_k if targets[i] != 0.0 else math.inf for i in range(2))
+        loop_k = (self._loop_k if targets[0] != 0.0 else math.inf,
+                  self._loop_k if targets[1] != 0.0 else math.inf)
         lin = linearise(contact, tuple(self.ref), ground, tuple(others), loop_k,
                         tuple(self.track_speed))
         return _Drives(ground, others, paddle, loop_k, contact, lin)
@@ -534,11 +535,11 @@ class SimCore:
             g_lin = g_next
             lin = linearise(contact, tuple(self.ref), g_lin, tuple(others), drives.loop_k,
                             tuple(lin.speed_mps))
-        if contact is not None and any(
-                (lin.speed_mps[i] - ground[i]) * (lin.speed_mps[i] - ground[i] - du
-                                                  + (1.0, -1.0)[i] * dr * half) < 0.0
-                for i in range(2)):
-            converged = False          # a track's slip would change sign within the step
+        if contact is not None:
+            slip_p, slip_s = lin.speed_mps[0] - ground[0], lin.speed_mps[1] - ground[1]
+            if slip_p * (slip_p - du + dr * half) < 0.0 \
+                    or slip_s * (slip_s - du - dr * half) < 0.0:
+                converged = False      # a track's slip would change sign within the step
         if converged:
             return du, dr, new, limited
         # the soil force is nearly a step at these slips (firm sand, low speed): the tracks
