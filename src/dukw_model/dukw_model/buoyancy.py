@@ -163,9 +163,25 @@ class HullSection:
         """
         r = self.radius_m
         d = np.minimum(depth_m, self.top_depth_m)
-        h = r - np.minimum(np.maximum(d, 0.0), min(self.float_depth_m, 2.0 * r))
-        out = r * r * np.arccos(h / r) - h * np.sqrt(np.maximum(r * r - h * h, 0))
-        out += self.strut_width_m * np.maximum(d - self.float_depth_m, 0.0)
+        # in place, the same operations on the same operands as
+        # h = r - min(max(d, 0), min(float_depth, 2r));
+        # r^2 acos(h / r) - h sqrt(max(r^2 - h^2, 0)) + strut max(d - float_depth, 0)
+        h = np.maximum(d, 0.0)
+        np.minimum(h, min(self.float_depth_m, 2.0 * r), out=h)
+        np.subtract(r, h, out=h)
+        out = h / r
+        np.arccos(out, out=out)
+        out *= r * r
+        root = h * h
+        np.subtract(r * r, root, out=root)
+        np.maximum(root, 0.0, out=root)
+        np.sqrt(root, out=root)
+        root *= h
+        out -= root
+        strut = np.subtract(d, self.float_depth_m, out=d)
+        np.maximum(strut, 0.0, out=strut)
+        strut *= self.strut_width_m
+        out += strut
         return out
 
     def max_area_m2(self) -> float:

@@ -173,3 +173,87 @@ def effective_weight_n(displacement_n: float, submerged_volume_m3: ArrayLike,
     buoyancy = water_density_kgpm3 * gravity_mps2 * np.asarray(submerged_volume_m3, dtype=float)
     out = np.maximum(displacement_n - buoyancy, 0.0) * np.cos(slope_rad)
     return float(out) if np.ndim(out) == 0 else out
+
+
+# ------------------------------------------------------------------ float paths (hot callers)
+# The simulator solves each track's speed loop against the soil with a few dozen force
+# evaluations per step: these take plain floats and a patch with its constants worked out
+# once, and give the same bits as ``slip`` and ``track_force_n`` (same operations in the same
+# order; expm1 is numpy's, whose vectorised routine is not libm's).
+
+def slip_f(track_speed_mps: float, ground_speed_mps: float,
+           min_track_speed_mps: float = 0.05) -> float:
+    """``slip`` of two floats, without the scalar/array dispatch."""
+    denom = max(abs(track_speed_mps), min_track_speed_mps) * (
+        1.0 if track_speed_mps >= 0.0 else -1.0)
+    return min(max((track_speed_mps - ground_speed_mps) / denom, -1.0), 1.0)
+
+
+class TrackPatch:
+    """One track's contact patch for ``track_force_f``: the arguments of ``track_force_n``
+    (weight, soil, area, length, suction, saturation) with tan(phi), the cohesion's share
+    and the contact pressure worked out once."""
+
+    __slots__ = ('weight_n', 'cohesion_n', 'tan_phi', 'area_m2', 'length_m', 'shear_modulus_m',
+                 'saturation', 'suction_ratio', 'max_suction_pa', 'pressure_pa', 'suction_on')
+
+    def __init__(self, weight_n: float, soil: SoilParams, contact_area_m2: float,
+                 contact_length_m: float, suction: SaturatedSandParams = NO_SUCTION,
+                 saturation: float = 0.0) -> None:
+        self.weight_n = max(float(weight_n), 0.0)
+        self.cohesion_n = contact_area_m2 * soil.cohesion_pa
+        self.tan_phi = _tan(soil.friction_angle_rad)
+        self.area_m2 = contact_area_m2
+        self.length_m = contact_length_m
+        self.shear_modulus_m = soil.shear_modulus_m
+        self.suction_on = saturation > 0.0 and suction.suction_ratio_per_mps > 0.0
+        self.saturation = min(max(float(saturation), 0.0), 1.0)
+        self.suction_ratio = suction.suction_ratio_per_mps
+        self.max_suction_pa = suction.max_pore_suction_pa
+        self.pressure_pa = self.weight_n / contact_area_m2
+
+    def strength_n(self, suction_pa: float = 0.0) -> float:
+        """``max_traction_n`` of the patch with this pore suction, N."""
+        normal = self.weight_n + self.area_m2 * suction_pa if suction_pa else self.weight_n
+        return self.cohesion_n + normal * self.tan_phi
+
+
+_TAN_OF: dict[float, float] = {}
+
+
+def _tan(phi_rad: float) -> float:
+    """float(np.tan(phi)), remembered per angle (numpy's tan is not libm's)."""
+    tan_phi = _TAN_OF.get(phi_rad)
+    if tan_phi is None:
+        tan_phi = _TAN_OF[phi_rad] = float(np.tan(phi_rad))
+    return tan_phi
+
+
+def track_force_f(patch: TrackPatch, track_speed_mps: float, ground_speed_mps: float) -> float:
+    """``track_force_n`` of one track in floats (same bits), N (+ forward)."""
+    v_t = track_speed_mps
+    denom = max(abs(v_t), 0.05) * (1.0 if v_t >= 0.0 else -1.0)
+    i = min(max((v_t - ground_speed_mps) / denom, -1.0), 1.0)
+    w = patch.weight_n
+    if i == 0.0 or w <= 0.0:                 # sign(i) x 0 strength: signed zeros as numpy's
+        h = 0.0 if i >= 0.0 else -0.0
+        return h if v_t >= 0.0 else -h
+    normal = w
+    if patch.suction_on:
+        s = patch.saturation * min(patch.suction_ratio * abs(v_t - ground_speed_mps)
+                                   * patch.pressure_pa, patch.max_suction_pa)
+        if s:
+            normal = w + patch.area_m2 * s
+    strength = patch.cohesion_n + normal * patch.tan_phi
+    k = patch.shear_modulus_m
+    s_abs = abs(i)
+    if k <= 1e-9:
+        dev = 1.0
+    else:
+        x = s_abs * patch.length_m / k
+        dev = x / 2.0 if x < 1e-6 else 1.0 + float(_expm1(-x)) / x
+    h = strength * dev if i > 0.0 else -strength * dev
+    return h if v_t >= 0.0 else -h
+
+
+_expm1 = np.expm1

@@ -174,3 +174,31 @@ def test_saturated_share_of_a_patch_on_a_plane_beach():
     assert traction.saturated_share(1.0, 0.1, 1.0) == 1.0
     assert traction.saturated_share(0.01, 0.0, 1.0) == 1.0         # level water over the patch
     assert traction.saturated_share(-0.01, 0.0, 1.0) == 0.0
+
+
+def _bits(values) -> list:
+    """Floats as their bit patterns (signed zeros differ)."""
+    return [float(v).hex() + ('-' if math.copysign(1.0, v) < 0 else '+') for v in values]
+
+
+@pytest.mark.parametrize('weight_n, saturation, soil', [
+    (1200.0, 0.0, SOIL), (1200.0, 0.6, SOIL), (1200.0, 1.0, SOIL), (0.0, 0.5, SOIL),
+    (800.0, 0.8, SoilParams(0.0, math.radians(31.0), 0.0))])
+def test_float_path_gives_the_array_path_bits(weight_n, saturation, soil):
+    """track_force_f / slip_f (the simulator's per-track calls) equal track_force_n / slip
+    of arrays to the bit, signed zeros included, with and without the pore suction."""
+    suction = SaturatedSandParams(suction_ratio_per_mps=0.9, max_pore_suction_pa=9000.0)
+    rng = np.random.default_rng(7)
+    speeds = np.concatenate([rng.uniform(-2.0, 2.0, 400), [0.0, -0.0, 0.01, -0.01, 0.3, -0.3]])
+    grounds = np.concatenate([rng.uniform(-2.0, 2.0, 400), [0.0, 0.0, 0.01, -0.01, 0.0, 0.0]])
+    grounds[:50] = speeds[:50]                                    # no slip
+    grounds[50:100] = speeds[50:100] + rng.normal(0.0, 1e-4, 50)  # nearly none
+    want = traction.track_force_n(speeds, grounds, weight_n, soil, A / 2, L, suction,
+                                  saturation)
+    patch = traction.TrackPatch(weight_n, soil, A / 2, L, suction, saturation)
+    pairs = list(zip(speeds.tolist(), grounds.tolist(), strict=True))
+    got = [traction.track_force_f(patch, v, g) for v, g in pairs]
+    assert _bits(got) == _bits(want)
+    slips = [traction.slip_f(v, g) for v, g in pairs]
+    assert _bits(slips) == _bits(traction.slip(speeds, grounds))
+    assert patch.strength_n(450.0) == traction.max_traction_n(weight_n, soil, A / 2, 450.0)

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Mapping
+from typing import Mapping, NamedTuple
 
 import numpy as np
 
@@ -49,8 +49,7 @@ _NEWTON_PASSES = 3             # implicit track-soil solve
 _NEWTON_TOL_MPS = 2e-4
 
 
-@dataclass(frozen=True)
-class TrackState:
+class TrackState(NamedTuple):
     """Both tracks after a step (port, starboard): speed, soil force, motor force, slip."""
 
     track_speed_mps: list
@@ -59,8 +58,7 @@ class TrackState:
     slip: list
 
 
-@dataclass(frozen=True)
-class _Drives:
+class _Drives(NamedTuple):
     """The track drives during a step, before the soil forces are solved for."""
 
     ground: tuple                # speed of the ground under each track, m/s (body surge)
@@ -71,9 +69,8 @@ class _Drives:
     lin: TrackLinear             # the soil forces linearised at the step's ground speeds
 
 
-@dataclass(frozen=True)
-class _Stepped:
-    """What a step leaves for the Truth beyond the state."""
+class _Stepped(NamedTuple):
+    """What a step leaves for the Truth beyond the state (NamedTuples: made every step)."""
 
     tracks: TrackState
     thrust_n: list
@@ -182,6 +179,12 @@ class SimCore:
         self._external = (0.0, 0.0, 0.0)
         self._hydro_key = None
         self._hydro_val = None
+        self._ground_key = None
+        self._ground_val = None
+        self._over_tracks_of = None
+        self._over_tracks = None
+        # the strips' squared distance from the centre of gravity (water yaw rate's weights)
+        self._station_r2 = self.hull.station_x_m ** 2 + self.hull.station_y_m ** 2
         self._wave_a2 = float(np.sum(self.world.waves.amplitude_m ** 2))
         self.reset()
 
@@ -252,7 +255,17 @@ class SimCore:
         self._external = (float(fx_n), float(fy_n), float(yaw_moment_nm))
 
     def _ground_pose(self) -> tuple[float, float, float, float]:
-        """Ground height at base_link, pitch and roll of a vehicle resting on it, slope."""
+        """Ground height at base_link, pitch and roll of a vehicle resting on it, slope
+        (remembered for the last position and heading: a step asks at its end and the next
+        one at its start)."""
+        key = (self.x, self.yaw)
+        if key == self._ground_key:
+            return self._ground_val
+        self._ground_val = self._ground_pose_at()
+        self._ground_key = key
+        return self._ground_val
+
+    def _ground_pose_at(self) -> tuple[float, float, float, float]:
         beach = self.world.beach
         c, s = math.cos(self.yaw), math.sin(self.yaw)
         half = self._track_len / 2.0
@@ -378,7 +391,8 @@ class SimCore:
         p, drive = self.params, self.vehicle.drivetrain
         targets = self._advance_speed_refs(act)
         ground = (self.u - self.r * self._half_sep, self.u + self.r * self._half_sep)
-        track_imm = min(max(float(depths.mean()) / self.seakeeping.equilibrium_depth_m, 0.0), 1.0)
+        mean_depth = float(depths.sum()) / depths.size         # depths.mean(), same bits
+        track_imm = min(max(mean_depth / self.seakeeping.equilibrium_depth_m, 0.0), 1.0)
         others = []
         paddle = []
         for i in range(2):
@@ -393,7 +407,8 @@ class SimCore:
             others.append(fric + pad)
         contact = self._track_contact(w_eff)
         # the speed loops give under load; at a zero command they hold the track (brake)
-        loop_k = tuple(self._loop_k if targets[i] != 0.0 else math.inf for i in range(2))
+        loop_k = (self._loop_k if targets[0] != 0.0 else math.inf,
+                  self._loop_k if targets[1] != 0.0 else math.inf)
         lin = linearise(contact, tuple(self.ref), ground, tuple(others), loop_k,
                         tuple(self.track_speed))
         return _Drives(ground, others, paddle, loop_k, contact, lin)
@@ -433,13 +448,18 @@ class SimCore:
         if not self.params.wave_moments.strip_moments or self.world.calm:
             return 0.0
         return water_yaw_rate_rps(areas, water, self.hull.station_x_m, self.hull.station_y_m,
-                                  yaw_cs)
+                                  yaw_cs, self._station_r2)
 
     def _water_over_tracks(self) -> np.ndarray:
         """Height of the surface over the sand at the strips along the tracks' contact, m."""
-        px, water = self._hydro()[:2]
-        n = self._n_stations
-        return (water.elevation_m[:n] - self.world.beach.heights_m(px[:n]))[self._track_strips]
+        hydro = self._hydro()
+        if self._over_tracks_of is not hydro:      # once per pose: contact, then resistance
+            px, water = hydro[:2]
+            n = self._n_stations
+            self._over_tracks = (water.elevation_m[:n]
+                                 - self.world.beach.heights_m(px[:n]))[self._track_strips]
+            self._over_tracks_of = hydro
+        return self._over_tracks
 
     def _track_wetness(self) -> float:
         """Share of the tracks' height under the surface (over the contact length), 0..1."""
@@ -487,7 +507,7 @@ class SimCore:
                   if limited[i] else self._loaded_speed(i, new[i] + others[i], loop_k[i])
                   for i in range(2)]
         self.track_speed = speeds
-        slips = traction.slip(np.array(speeds), np.array(ground_new)).tolist()
+        slips = [traction.slip_f(speeds[i], ground_new[i]) for i in range(2)]
         c, s = yaw_cs
         self.yaw = (self.yaw + dt * self.r + math.pi) % (2.0 * math.pi) - math.pi
         self.x += dt * (c * self.u - s * self.v)
@@ -515,11 +535,11 @@ class SimCore:
             g_lin = g_next
             lin = linearise(contact, tuple(self.ref), g_lin, tuple(others), drives.loop_k,
                             tuple(lin.speed_mps))
-        if contact is not None and any(
-                (lin.speed_mps[i] - ground[i]) * (lin.speed_mps[i] - ground[i] - du
-                                                  + (1.0, -1.0)[i] * dr * half) < 0.0
-                for i in range(2)):
-            converged = False          # a track's slip would change sign within the step
+        if contact is not None:
+            slip_p, slip_s = lin.speed_mps[0] - ground[0], lin.speed_mps[1] - ground[1]
+            if slip_p * (slip_p - du + dr * half) < 0.0 \
+                    or slip_s * (slip_s - du - dr * half) < 0.0:
+                converged = False      # a track's slip would change sign within the step
         if converged:
             return du, dr, new, limited
         # the soil force is nearly a step at these slips (firm sand, low speed): the tracks

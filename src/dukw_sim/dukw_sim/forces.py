@@ -12,7 +12,6 @@ the last bit of results that are recorded in the golden bags.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -24,6 +23,8 @@ _ROLL_EPS_MPS = 0.005          # regularisation of Coulomb rolling resistance
 _FRICTION_EPS_MPS = 0.02       # of drivetrain friction
 _BREAKAWAY_MPS = 0.05          # below this track speed the breakaway friction applies
 LATERAL_POINTS = 5             # points along each track for the lateral resistance
+# np.clip's ufunc without its Python wrappers (np.clip of floats calls it; same bits)
+_clip = getattr(getattr(np, '_core', None), 'umath', np).clip
 
 
 class Wrench(NamedTuple):
@@ -42,8 +43,7 @@ class Wrench(NamedTuple):
     dn_dr: float | None = None
 
 
-@dataclass(frozen=True)
-class BodyForces:
+class BodyForces(NamedTuple):
     """The sum of all wrenches of a step (body axes), with its derivatives."""
 
     x_n: float
@@ -66,8 +66,7 @@ def sum_wrenches(terms: list[Wrench]) -> BodyForces:
     return BodyForces(*total)
 
 
-@dataclass(frozen=True)
-class Immersion:
+class Immersion(NamedTuple):
     """The hull strips in the water: their buoyancy, the volume and its afloat share."""
 
     strip_force_n: np.ndarray   # buoyancy of each hull strip, N
@@ -85,8 +84,7 @@ def immersion(areas_m2: np.ndarray, strip_length_m: float, rho_g: float,
     return Immersion(strip_f, buoy, volume, min(volume / afloat_volume_m3, 1.0))
 
 
-@dataclass(frozen=True)
-class WaveForcing:
+class WaveForcing(NamedTuple):
     """Wave force on the hull in odom (N) and the mean water velocity at it (m/s)."""
 
     fx_n: float
@@ -119,21 +117,26 @@ def wave_forcing(calm: bool, areas_m2: np.ndarray, strip_length_m: float, water:
 
 
 def water_yaw_rate_rps(areas_m2: np.ndarray, water: WaterSample, station_x_m: np.ndarray,
-                       station_y_m: np.ndarray, yaw_cs: tuple) -> float:
+                       station_y_m: np.ndarray, yaw_cs: tuple,
+                       radius_sq_m2: np.ndarray | None = None) -> float:
     """The water's own yaw rate over the hull: the least-squares rotation of the wave particle
     velocity at the immersed strips (body axes, immersed area as weight), rad/s.
 
     The hull drag acts on the velocity relative to the water, strip by strip; in a
     short-crested sea the transverse water velocity differs along the hulls (and the surge
     velocity between them), so the yaw damping acts on r minus this rate, as the surge and sway
-    drag act on u and v minus the water's mean velocity (``wave_forcing``)."""
-    c, s = yaw_cs
-    n = station_x_m.size
-    ub = c * water.velocity_x_mps[:n] + s * water.velocity_y_mps[:n]
-    vb = -s * water.velocity_x_mps[:n] + c * water.velocity_y_mps[:n]
-    weight = float(areas_m2 @ (station_x_m ** 2 + station_y_m ** 2))
+    drag act on u and v minus the water's mean velocity (``wave_forcing``). ``radius_sq_m2``:
+    the strips' x^2 + y^2 if the caller keeps it."""
+    if radius_sq_m2 is None:
+        radius_sq_m2 = station_x_m ** 2 + station_y_m ** 2
+    weight = float(areas_m2 @ radius_sq_m2)
     if weight <= 1e-12:
         return 0.0
+    c, s = yaw_cs
+    n = station_x_m.size
+    vel_x, vel_y = water.velocity_x_mps[:n], water.velocity_y_mps[:n]
+    ub = c * vel_x + s * vel_y
+    vb = -s * vel_x + c * vel_y
     return float(areas_m2 @ (station_x_m * vb - station_y_m * ub)) / weight
 
 
@@ -163,8 +166,9 @@ def wave_moments(calm: bool, areas_m2: np.ndarray, strip_length_m: float, water:
     off_x = c * station_x_m - s * station_y_m
     off_y = s * station_x_m + c * station_y_m
     yaw = float(off_x @ fy - off_y @ fx)
-    fx_body = c * float(fx.sum()) + s * float(fy.sum())
-    fy_body = -s * float(fx.sum()) + c * float(fy.sum())
+    fx_sum, fy_sum = float(fx.sum()), float(fy.sum())
+    fx_body = c * fx_sum + s * fy_sum
+    fy_body = -s * fx_sum + c * fy_sum
     # REP 103: a force to port below the centre of gravity lifts the port side (+ roll); a
     # force forward below it lifts the bow (- pitch)
     return WaveMoments(yaw, -lever_z_m * fy_body, lever_z_m * fx_body)
@@ -175,7 +179,8 @@ def track_wetness(water_over_ground_m: np.ndarray, track_height_m: float) -> flo
     mean of the given points along the tracks."""
     if water_over_ground_m.size == 0:
         return 0.0
-    return float(np.mean(np.clip(water_over_ground_m / track_height_m, 0.0, 1.0)))
+    share = _clip(water_over_ground_m / track_height_m, 0.0, 1.0)
+    return float(share.sum()) / share.size                     # np.mean, same bits
 
 
 def saturated_share(water_over_ground_m: np.ndarray) -> float:

@@ -13,6 +13,7 @@ The force on the vehicle (a track running backwards pushes backwards) is the sha
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -39,6 +40,12 @@ class TrackContact:
     suction: SaturatedSandParams = traction.NO_SUCTION   # saturated sand's dilatancy
     saturation: float = 0.0  # 0 dry sand .. 1 saturated (the tracks' wetted share)
 
+    @functools.cached_property
+    def patch(self) -> traction.TrackPatch:
+        """One track's patch for ``traction.track_force_f`` (the float path of forces_n)."""
+        return traction.TrackPatch(self.weight_per_track_n, self.soil, self.area_m2,
+                                   self.length_m, self.suction, self.saturation)
+
     def forces_n(self, track_mps: np.ndarray, ground_mps: np.ndarray) -> np.ndarray:
         """Force on the vehicle from tracks at ``track_mps`` over ground speeds, N (+ forward)."""
         return np.asarray(traction.track_force_n(track_mps, ground_mps, self.weight_per_track_n,
@@ -49,8 +56,7 @@ class TrackContact:
         """The patch's shear strength, N: without pore suction (no slip velocity), or with
         the most suction the saturated sand can hold (``slipping``: a bound at any slip)."""
         suction_pa = self.saturation * self.suction.max_pore_suction_pa if slipping else 0.0
-        return float(traction.max_traction_n(self.weight_per_track_n, self.soil, self.area_m2,
-                                             suction_pa))
+        return self.patch.strength_n(suction_pa)      # traction.max_traction_n, in floats
 
 
 @dataclass
@@ -62,30 +68,35 @@ class TrackLinear:
     speed_mps: list = field(default_factory=lambda: [0.0, 0.0])   # the tracks' speeds
 
 
-def _compliant_speeds(contact: TrackContact, ref: np.ndarray, ground: np.ndarray,
-                      others: np.ndarray, stiffness: np.ndarray,
-                      guess: np.ndarray) -> np.ndarray:
+def _compliant_speeds(patch: traction.TrackPatch, strength: float, ref: list, ground: list,
+                      others: list, stiffness: list, guess: list) -> list:
     """Track speeds where the speed loops' force k (ref - v) equals soil + other forces.
 
     h(v) = F_soil(v, g) + others - k (ref - v) rises with v; safeguarded Newton inside the
-    bracket the soil's strength S gives: v in [ref - (S + o)/k, ref + (S - o)/k].
+    bracket the soil's strength S gives: v in [ref - (S + o)/k, ref + (S - o)/k]. Both tracks
+    step together until both have converged; in floats (numpy on two tracks costs more than
+    the physics), the same bits as the vectorised form. Returns the speeds and, when they
+    converged, the soil forces there (else None).
     """
-    strength = contact.strength_n(slipping=True)
-    lo = ref - (strength + others) / stiffness
-    hi = ref + (strength - others) / stiffness
-    v = np.clip(guess, lo, hi)
+    force = traction.track_force_f
+    lo = [ref[i] - (strength + others[i]) / stiffness[i] for i in range(2)]
+    hi = [ref[i] + (strength - others[i]) / stiffness[i] for i in range(2)]
+    v = [min(max(guess[i], lo[i]), hi[i]) for i in range(2)]
     for _ in range(_COMPLIANCE_ITERATIONS):
-        f = contact.forces_n(np.concatenate([v, v + _PROBE_MPS]), np.concatenate([ground,
-                                                                                 ground]))
-        h = f[:2] + others - stiffness * (ref - v)
-        if np.all(np.abs(h) < _COMPLIANCE_TOL_N):
-            break
-        hi = np.where(h > 0.0, v, hi)
-        lo = np.where(h > 0.0, lo, v)
-        slope = (f[2:] - f[:2]) / _PROBE_MPS + stiffness
-        step = v - h / slope
-        v = np.where((step > lo) & (step < hi), step, 0.5 * (lo + hi))
-    return v
+        f = [force(patch, v[0], ground[0]), force(patch, v[1], ground[1])]
+        h = [f[i] + others[i] - stiffness[i] * (ref[i] - v[i]) for i in range(2)]
+        if abs(h[0]) < _COMPLIANCE_TOL_N and abs(h[1]) < _COMPLIANCE_TOL_N:
+            return v, f
+        for i in range(2):
+            if h[i] > 0.0:
+                hi[i] = v[i]
+            else:
+                lo[i] = v[i]
+            slope = (force(patch, v[i] + _PROBE_MPS, ground[i]) - f[i]) / _PROBE_MPS \
+                + stiffness[i]
+            step = v[i] - h[i] / slope
+            v[i] = step if lo[i] < step < hi[i] else 0.5 * (lo[i] + hi[i])
+    return v, None
 
 
 def linearise(contact: TrackContact | None, ref_mps: tuple, ground_mps: tuple,
@@ -100,27 +111,31 @@ def linearise(contact: TrackContact | None, ref_mps: tuple, ground_mps: tuple,
     """
     if contact is None:
         return TrackLinear([0.0, 0.0], [0.0, 0.0], list(ref_mps))
-    ref = np.asarray(ref_mps, dtype=float)
-    ground = np.asarray(ground_mps, dtype=float)
-    stiff = np.asarray(stiffness_n_per_mps, dtype=float)
-    soft = np.isfinite(stiff)
-    speed = ref.copy()
-    if soft.any():
-        guess = ref if guess_mps is None else np.asarray(guess_mps, dtype=float)
-        k_soft = np.where(soft, stiff, 1.0)
-        speed = np.where(soft, _compliant_speeds(contact, ref, ground,
-                                                 np.asarray(others_n, dtype=float), k_soft,
-                                                 guess), ref)
-    t = np.array([speed[0], speed[0], speed[0] + _PROBE_MPS,
-                  speed[1], speed[1], speed[1] + _PROBE_MPS])
-    g = np.array([ground[0], ground[0] + _PROBE_MPS, ground[0],
-                  ground[1], ground[1] + _PROBE_MPS, ground[1]])
-    f = contact.forces_n(t, g).tolist()
-    d_g = [(f[1] - f[0]) / _PROBE_MPS, (f[4] - f[3]) / _PROBE_MPS]
-    d_t = [(f[2] - f[0]) / _PROBE_MPS, (f[5] - f[3]) / _PROBE_MPS]
-    d_g = [float(d_g[i] * stiff[i] / (stiff[i] + d_t[i])) if soft[i] else d_g[i]
+    ref = [float(r) for r in ref_mps]
+    ground = [float(g) for g in ground_mps]
+    stiff = [float(k) for k in stiffness_n_per_mps]
+    soft = [math.isfinite(k) for k in stiff]
+    patch = contact.patch
+    force = traction.track_force_f
+    speed = ref
+    f0 = None
+    if soft[0] or soft[1]:
+        guess = ref if guess_mps is None else [float(g) for g in guess_mps]
+        k_soft = [stiff[i] if soft[i] else 1.0 for i in range(2)]
+        loaded, f_loaded = _compliant_speeds(patch, contact.strength_n(slipping=True), ref,
+                                             ground, [float(o) for o in others_n], k_soft,
+                                             guess)
+        speed = [loaded[i] if soft[i] else ref[i] for i in range(2)]
+        if f_loaded is not None and soft[0] and soft[1]:
+            f0 = f_loaded                           # the forces at the converged speeds
+    if f0 is None:
+        f0 = [force(patch, speed[i], ground[i]) for i in range(2)]
+    d_g = [(force(patch, speed[i], ground[i] + _PROBE_MPS) - f0[i]) / _PROBE_MPS
            for i in range(2)]
-    return TrackLinear([f[0], f[3]], d_g, speed.tolist())
+    d_t = [(force(patch, speed[i] + _PROBE_MPS, ground[i]) - f0[i]) / _PROBE_MPS
+           for i in range(2)]
+    d_g = [d_g[i] * stiff[i] / (stiff[i] + d_t[i]) if soft[i] else d_g[i] for i in range(2)]
+    return TrackLinear(f0, d_g, list(speed))
 
 
 def motor_limited_speed(contact: TrackContact | None, ref_mps: float, ground_mps: float,

@@ -15,10 +15,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 GRAVITY_MPS2 = 9.81
+# np.interp without its Python wrapper (real values: the wrapper calls this, same result)
+_interp = getattr(getattr(np, '_core', None), 'multiarray', np).interp
 _MIN_KINEMATIC_DEPTH_M = 0.05
 
 
@@ -225,12 +228,11 @@ def no_waves() -> WaveComponents:
     return WaveComponents(empty, empty, empty, empty, empty)
 
 
-@dataclass(frozen=True)
-class WaterSample:
+class WaterSample(NamedTuple):
     """The water at a set of points: surface elevation, and particle kinematics.
 
     Velocity and acceleration are horizontal, in odom, at the points' heights
-    (clipped into the water column).
+    (clipped into the water column). A NamedTuple: one is made every physics step.
     """
 
     elevation_m: np.ndarray
@@ -280,6 +282,8 @@ class World:
         self._wavenumbers[3] = -0.5 * math.pi
         self._time_key: float | None = None
         self._transfer_key: tuple[float, float] | None = None
+        self._sinh_depth: float | None = None
+        self._sinh_kd = np.zeros(0)
         self._points = np.zeros((0, 4))
         self._points_key = (0, 0)
         self._still_x = np.array([beach.flat_start_x_m, beach.sea_floor_x_m])
@@ -349,31 +353,43 @@ class World:
         if n and x.max() <= 0.0:                  # all on the sand: breaking leaves no wave
             kin = np.zeros(kin_points)
             return WaterSample(np.zeros(shape), kin, kin, kin, kin)
+        sample = self.sample_points(x, y, t_s, kin_points, kin_height_m)
+        return sample if shape == (n,) else sample._replace(elevation_m=sample.elevation_m
+                                                            .reshape(shape))
+
+    def sample_points(self, x: np.ndarray, y: np.ndarray, t_s: float, kin_points: int,
+                      kin_height_m: float) -> WaterSample:
+        """``sample`` of flat float arrays x, y of n points, 0 <= kin_points <= n, waves
+        present and some point seaward of the waterline (the simulator's call every step,
+        without the checks)."""
+        n = x.size
         rows = self._point_rows(x, y, kin_points)
         trig = np.cos(rows @ self._phase_matrix(t_s))   # cos on the first n rows, then sin
-        factor = np.interp(rows[:, 0], self._cap_x, self._cap)
+        factor = _interp(rows[:, 0], self._cap_x, self._cap)
         if kin_points:
             self._set_transfer(x[:kin_points], kin_height_m)
             out = trig @ self._weights
         else:
             out = trig @ self._weights[:, :1]
         out *= factor[:, None]
-        eta = out[:n, 0].reshape(shape)
         if not kin_points:
             kin = np.zeros(0)
-            return WaterSample(eta, kin, kin, kin, kin)
-        return WaterSample(eta, out[:kin_points, 1], out[:kin_points, 2], out[n:, 3],
+            return WaterSample(out[:n, 0], kin, kin, kin, kin)
+        return WaterSample(out[:n, 0], out[:kin_points, 1], out[:kin_points, 2], out[n:, 3],
                            out[n:, 4])
 
     def _set_transfer(self, x_kin: np.ndarray, kin_height_m: float) -> None:
         """Kinematic weights times cosh k(z + d) / sinh k d at the points' mean still depth."""
-        depth = float(np.interp(x_kin, self._still_x, self._still_depth).sum()) / x_kin.size
+        depth = float(_interp(x_kin, self._still_x, self._still_depth).sum()) / x_kin.size
         depth = max(depth, _MIN_KINEMATIC_DEPTH_M)
         zc = min(max(kin_height_m, -depth), 0.0)
         if (zc, depth) == self._transfer_key:     # e.g. the hull above the water
             return
+        if depth != self._sinh_depth:             # e.g. off the slope: the sea floor's depth
+            self._sinh_kd = np.sinh(self._k * depth)
+            self._sinh_depth = depth
         transfer = np.cosh(self._k * (zc + depth))
-        transfer /= np.sinh(self._k * depth)
+        transfer /= self._sinh_kd
         np.multiply(transfer[:, None], self._kin_weights, out=self._weights[:, 1:])
         self._transfer_key = (zc, depth)
 
