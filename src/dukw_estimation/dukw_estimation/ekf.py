@@ -61,7 +61,7 @@ class Outcome(Enum):
     IGNORED = 'ignored'          # disabled sensor, no fix, nothing to learn
 
 
-@dataclass
+@dataclass(frozen=True)
 class ProcessNoise:
     """Continuous-time process noise densities (sigma per sqrt(s)) and the wave model."""
 
@@ -93,6 +93,9 @@ class MotionEkf:
         self.noise = noise
         self.seaward_yaw_rad = seaward_yaw_rad
         self._eye = np.eye(N_STATES)
+        # process noise variance rates (diagonal of Q / dt) by acceleration noise: the noise
+        # is frozen, and the predictions use one or two acceleration noises
+        self._q_rates: dict[float, np.ndarray] = {}
 
     def predict(self, dt: float, accel_body: tuple[float, float] | None = None,
                 drive_target: tuple[float, float, float] | None = None,
@@ -148,14 +151,21 @@ class MotionEkf:
         x[_GBE] *= decay
         x[_GBN] *= decay
         F[_GBE, _GBE] = F[_GBN, _GBN] = decay
-        bias_q = 2.0 * n.gps_bias_sigma_m ** 2 / n.gps_bias_tau_s
         accel = n.accel_mps2 if accel_noise_mps2 is None else accel_noise_mps2
-        q = np.array([n.position_m ** 2, n.position_m ** 2, n.yaw_rad ** 2, accel ** 2,
-                      accel ** 2, n.yaw_accel_rps2 ** 2, n.gyro_bias_rps ** 2,
-                      n.waterline_m ** 2, 0.0, n.wave_drive(), bias_q, bias_q]) * dt
+        q_rate = self._q_rates.get(accel)
+        if q_rate is None:
+            q_rate = self._q_rates[accel] = self._q_rate(accel)
         P = F @ self.P @ F.T
-        P[np.diag_indices(N_STATES)] += q
+        P.reshape(-1)[::N_STATES + 1] += q_rate * dt     # the diagonal (a view of P)
         self.P = P
+
+    def _q_rate(self, accel_mps2: float) -> np.ndarray:
+        """The diagonal of the process noise per second with this acceleration noise."""
+        n = self.noise
+        bias_q = 2.0 * n.gps_bias_sigma_m ** 2 / n.gps_bias_tau_s
+        return np.array([n.position_m ** 2, n.position_m ** 2, n.yaw_rad ** 2, accel_mps2 ** 2,
+                         accel_mps2 ** 2, n.yaw_accel_rps2 ** 2, n.gyro_bias_rps ** 2,
+                         n.waterline_m ** 2, 0.0, n.wave_drive(), bias_q, bias_q])
 
     def update(self, z: np.ndarray, hx: np.ndarray, H: np.ndarray, R: np.ndarray,
                gate: float, angle_rows: tuple[int, ...] = ()) -> Outcome:

@@ -30,10 +30,16 @@ GROUNDED_FRACTION = 0.5          # above this weight share the tracks drive the 
 #: filter does not estimate is fixed; the rest is copied from P with precomputed indices
 _POSE_COV_BASE = np.diag([0.0, 0.0, 1e3, 1e-2, 1e-2, 0.0])
 _TWIST_COV_BASE = np.diag([0.0, 0.0, 1e3, 1e3, 1e3, 0.0])
-_POSE_AT = np.ix_([0, 1, 5], [0, 1, 5])
-_POSE_FROM = np.ix_([Idx.X, Idx.Y, Idx.YAW], [Idx.X, Idx.Y, Idx.YAW])
-_TWIST_AT = np.ix_([0, 1], [0, 1])
-_TWIST_FROM = np.ix_([Idx.U, Idx.V], [Idx.U, Idx.V])
+#: (row, column in the message's covariance, row, column in P): x, y, yaw -> x, y, yaw;
+#: u, v -> vx, vy; r -> wz (no u, v - r terms). Element by element: fancy indexing costs
+#: more than these few items
+_POSE_COPY = tuple((a, b, int(i), int(j)) for a, i in zip((0, 1, 5), (Idx.X, Idx.Y, Idx.YAW))
+                   for b, j in zip((0, 1, 5), (Idx.X, Idx.Y, Idx.YAW)))
+_TWIST_COPY = tuple((a, b, int(i), int(j)) for a, i in zip((0, 1, 5), (Idx.U, Idx.V, Idx.R))
+                    for b, j in zip((0, 1, 5), (Idx.U, Idx.V, Idx.R))
+                    if (a == 5) == (b == 5))
+_X, _Y, _YAW, _U, _V, _R, _S = (int(Idx.X), int(Idx.Y), int(Idx.YAW), int(Idx.U), int(Idx.V),
+                                int(Idx.R), int(Idx.S))
 
 class MotionFilter:
     """Pose, twist, gyro bias and GPS bias of base_link in odom (and the EKF's time)."""
@@ -266,14 +272,16 @@ class MotionFilter:
     def odometry(self, slope_rad: float) -> OdometryEstimate:
         """Pose and twist of base_link in odom with covariances (z on the slope)."""
         x, P = self.ekf.x, self.ekf.P
-        roll = self.imu.roll_rad if self.imu else 0.0
-        pitch = self.imu.pitch_rad if self.imu else 0.0
+        imu = self.imu
+        roll = imu.roll_rad if imu else 0.0
+        pitch = imu.pitch_rad if imu else 0.0
         pose_cov = _POSE_COV_BASE.copy()
-        pose_cov[_POSE_AT] = P[_POSE_FROM]          # x, y, yaw of the filter -> x, y, yaw
+        for a, b, i, j in _POSE_COPY:
+            pose_cov[a, b] = P[i, j]
         twist_cov = _TWIST_COV_BASE.copy()
-        twist_cov[_TWIST_AT] = P[_TWIST_FROM]       # u, v -> vx, vy
-        twist_cov[5, 5] = P[Idx.R, Idx.R]           # r -> wz (no u, v - r terms)
-        z = -x[Idx.S] * math.sin(slope_rad)
-        return OdometryEstimate(self.t_s or 0.0, float(x[Idx.X]), float(x[Idx.Y]), z, roll,
-                                pitch, float(x[Idx.YAW]), float(x[Idx.U]), float(x[Idx.V]),
-                                float(x[Idx.R]), pose_cov, twist_cov)
+        for a, b, i, j in _TWIST_COPY:
+            twist_cov[a, b] = P[i, j]
+        z = -x[_S] * math.sin(slope_rad)
+        return OdometryEstimate(self.t_s or 0.0, float(x[_X]), float(x[_Y]), z, roll,
+                                pitch, float(x[_YAW]), float(x[_U]), float(x[_V]),
+                                float(x[_R]), pose_cov, twist_cov)
