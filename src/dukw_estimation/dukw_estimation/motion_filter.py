@@ -33,11 +33,11 @@ _TWIST_COV_BASE = np.diag([0.0, 0.0, 1e3, 1e3, 1e3, 0.0])
 #: (row, column in the message's covariance, row, column in P): x, y, yaw -> x, y, yaw;
 #: u, v -> vx, vy; r -> wz (no u, v - r terms). Element by element: fancy indexing costs
 #: more than these few items
-_POSE_COPY = tuple((a, b, int(i), int(j)) for a, i in zip((0, 1, 5), (Idx.X, Idx.Y, Idx.YAW))
-                   for b, j in zip((0, 1, 5), (Idx.X, Idx.Y, Idx.YAW)))
-_TWIST_COPY = tuple((a, b, int(i), int(j)) for a, i in zip((0, 1, 5), (Idx.U, Idx.V, Idx.R))
-                    for b, j in zip((0, 1, 5), (Idx.U, Idx.V, Idx.R))
-                    if (a == 5) == (b == 5))
+_POSE_MAP = ((0, Idx.X), (1, Idx.Y), (5, Idx.YAW))
+_TWIST_MAP = ((0, Idx.U), (1, Idx.V))
+_POSE_COPY = tuple((a, b, int(i), int(j)) for a, i in _POSE_MAP for b, j in _POSE_MAP)
+_TWIST_COPY = tuple((a, b, int(i), int(j)) for a, i in _TWIST_MAP
+                    for b, j in _TWIST_MAP) + ((5, 5, int(Idx.R), int(Idx.R)),)
 _X, _Y, _YAW, _U, _V, _R, _S = (int(Idx.X), int(Idx.Y), int(Idx.YAW), int(Idx.U), int(Idx.V),
                                 int(Idx.R), int(Idx.S))
 
