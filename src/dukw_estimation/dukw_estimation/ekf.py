@@ -177,6 +177,8 @@ class MotionEkf:
             y[row] = wrap_angle(y[row])
         PHt = self.P @ H.T
         S = H @ PHt + R
+        if S.shape == (2, 2) and R[0, 1] == 0.0 and R[1, 0] == 0.0:
+            return self._update_rows_2d(y, H, R, S, gate)
         try:
             S_inv = np.linalg.inv(S)
         except np.linalg.LinAlgError:
@@ -196,6 +198,26 @@ class MotionEkf:
         self.x[_YAW] = wrap_angle(self.x[_YAW])
         I_KH = self._eye - K @ H
         self.P = I_KH @ self.P @ I_KH.T + K @ R @ K.T
+        return Outcome.ACCEPTED
+
+    def _update_rows_2d(self, y: np.ndarray, H: np.ndarray, R: np.ndarray, S: np.ndarray,
+                        gate: float) -> Outcome:
+        """``update`` of a 2-D measurement with a diagonal R (the DGPS's, the tracks'): the
+        gate's Mahalanobis distance from the 2x2 inverse in closed form (a singular S is
+        rejected, as ``inv`` would), then the two rows in turn."""
+        a, b, c, d = float(S[0, 0]), float(S[0, 1]), float(S[1, 0]), float(S[1, 1])
+        det = a * d - b * c
+        if det == 0.0:
+            return Outcome.REJECTED_OUTLIER
+        y0, y1 = float(y[0]), float(y[1])
+        d2 = (y0 * (d * y0 - b * y1) + y1 * (a * y1 - c * y0)) / det
+        if not math.isfinite(d2) or d2 > gate * gate:
+            return Outcome.REJECTED_OUTLIER
+        x_start = self.x.copy()
+        self.update_scalar(y0, 0.0, H[0], float(R[0, 0]), math.inf)
+        # the second row's residual moves with the state the first row corrected
+        residual = y[1] - float(H[1] @ (self.x - x_start))
+        self.update_scalar(residual, 0.0, H[1], float(R[1, 1]), math.inf)
         return Outcome.ACCEPTED
 
     def update_scalar(self, z: float, hx: float, h: np.ndarray, var: float,

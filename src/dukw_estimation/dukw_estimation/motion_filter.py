@@ -40,6 +40,14 @@ _TWIST_COPY = tuple((a, b, int(i), int(j)) for a, i in _TWIST_MAP
                     for b, j in _TWIST_MAP) + ((5, 5, int(Idx.R), int(Idx.R)),)
 _X, _Y, _YAW, _U, _V, _R, _S = (int(Idx.X), int(Idx.Y), int(Idx.YAW), int(Idx.U), int(Idx.V),
                                 int(Idx.R), int(Idx.S))
+_BIAS = int(Idx.BIAS)
+#: the IMU's measurement rows (read only): the gyro's z rate r + bias, the heading yaw
+_H_GYRO = np.zeros(N_STATES)
+_H_GYRO[[_R, _BIAS]] = 1.0
+_H_GYRO.flags.writeable = False
+_H_YAW = np.zeros(N_STATES)
+_H_YAW[_YAW] = 1.0
+_H_YAW.flags.writeable = False
 
 class MotionFilter:
     """Pose, twist, gyro bias and GPS bias of base_link in odom (and the EKF's time)."""
@@ -166,19 +174,16 @@ class MotionFilter:
         self.accel_base = self._accel_at_base_link(s, dt)
         self.imu = s
         st = self.settings
-        h = np.zeros(N_STATES)
-        h[Idx.R] = h[Idx.BIAS] = 1.0
         var = s.yaw_rate_var_rps2 if s.yaw_rate_var_rps2 > 0 else st.gyro_rps ** 2
-        out = self.ekf.update_scalar(s.yaw_rate_rps, self.ekf.x[Idx.R] + self.ekf.x[Idx.BIAS],
-                                     h, var, st.gate_imu)
+        x = self.ekf.x
+        out = self.ekf.update_scalar(s.yaw_rate_rps, x[_R] + x[_BIAS], _H_GYRO, var,
+                                     st.gate_imu)
         if math.isfinite(s.yaw_rad):
             if not self.yaw_set:
                 self.ekf.x[Idx.YAW] = wrap_angle(s.yaw_rad)
                 self.yaw_set = True
-            h = np.zeros(N_STATES)
-            h[Idx.YAW] = 1.0
             var = s.yaw_var_rad2 if s.yaw_var_rad2 > 0 else st.yaw_rad ** 2
-            yaw_out = self.ekf.update_scalar(s.yaw_rad, self.ekf.x[Idx.YAW], h, var,
+            yaw_out = self.ekf.update_scalar(s.yaw_rad, self.ekf.x[_YAW], _H_YAW, var,
                                              st.gate_imu, angle=True)
             if yaw_out is not Outcome.ACCEPTED:
                 out = yaw_out
