@@ -27,6 +27,7 @@ TOUCHDOWN_SHARE = 0.8           # afloat until the mean-surface volume drops bel
 #: hull volumes remembered by their inputs (one sample asks for the same volume several
 #: times: the contact decision, the traction output, the force update's prediction)
 VOLUME_CACHE_SIZE = 16
+DRY_MARGIN_M = 1e-6              # the surface this far below the hulls' bottom line: no volume
 # plain ints for the hot paths (indexing numpy with IntEnum members is slower)
 _YAW, _U, _R, _S, _ETA = int(Idx.YAW), int(Idx.U), int(Idx.R), int(Idx.S), int(Idx.ETA)
 
@@ -187,10 +188,25 @@ class ContactModel:
             if len(volumes) >= VOLUME_CACHE_SIZE:
                 volumes.clear()
             body = self.vehicle.body
-            volume = volumes[key] = buoyancy.grounded_volume_m3(
-                waterline_distance_m, self.slope_rad, body.hull_clearance_m, self.hull_bow_x_m,
-                self.hull_stern_x_m, body.hull_radius_m, surface_m, heading_cos, self.section)
+            if self._dry(waterline_distance_m, surface_m, heading_cos):
+                volume = volumes[key] = 0.0
+            else:
+                volume = volumes[key] = buoyancy.grounded_volume_m3(
+                    waterline_distance_m, self.slope_rad, body.hull_clearance_m,
+                    self.hull_bow_x_m, self.hull_stern_x_m, body.hull_radius_m, surface_m,
+                    heading_cos, self.section)
         return volume
+
+    def _dry(self, waterline_distance_m: float, surface_m: float, heading_cos: float) -> bool:
+        """The surface clearly (``DRY_MARGIN_M``) below both ends of the hulls' bottom line:
+        ``buoyancy.grounded_volume_m3`` would integrate nothing and return 0.0 (on the sand,
+        most samples); computed with its own bottom line."""
+        depth0, gradient = buoyancy._bottom_depth_line(   # noqa: SLF001 - the same line
+            waterline_distance_m, self.slope_rad, self.vehicle.body.hull_clearance_m,
+            surface_m, heading_cos)
+        deepest = max(depth0 + gradient * self.hull_bow_x_m,
+                      depth0 + gradient * self.hull_stern_x_m)
+        return deepest < -DRY_MARGIN_M
 
     def surface_volume_m3(self, x: np.ndarray, raise_m: float = 0.0) -> float:
         """The volume under a surface ``raise_m`` above the estimated one, m^3 (0: dry)."""
