@@ -156,8 +156,9 @@ class ContactModel:
         st = self.settings
         if st.contact_track_force_n <= 0.0 or tracks is None or not tracks_fresh:
             return False
-        return all(abs(self.measured_soil_force_n(tracks, k)) >= st.contact_track_force_n
-                   for k in range(2))
+        limit = st.contact_track_force_n
+        return (abs(self.measured_soil_force_n(tracks, 0)) >= limit
+                and abs(self.measured_soil_force_n(tracks, 1)) >= limit)
 
     # ------------------------------------------------------------------ submersion
     def submersion(self, x: np.ndarray) -> tuple[float, float]:
