@@ -112,19 +112,21 @@ class _Driver:
     def compare(self, topic: str, t_ns: int, msg: Any) -> None:
         recorded = self.adapter.recorded(topic, msg)
         replayed = self.latest or {}
-        deviations, angles, isnan = self.deviations, self.adapter.angle_quantities, math.isnan
+        deviations, angles, nan = self.deviations, self.adapter.angle_quantities, math.nan
         for quantity, value in recorded.items():
             dev = deviations.get(quantity)
             if dev is None:     # (not setdefault: it would build a Deviation every time)
                 dev = deviations[quantity] = Deviation(self.adapter.name, quantity)
-            mine = replayed.get(quantity, math.nan)
-            diff = 0.0 if isnan(mine) and isnan(value) else abs(mine - value)
-            if diff > math.pi and quantity in angles:
+            mine = replayed.get(quantity, nan)
+            diff = abs(mine - value)
+            if diff != diff:                  # NaN: both NaN is a match, one NaN is not
+                if mine != mine and value != value:
+                    diff = 0.0
+            elif diff > math.pi and quantity in angles:
                 diff = abs(math.remainder(mine - value, math.tau))
-            dev.compared += 1
-            worse = (dev.compared == 1 or diff > dev.max_abs
-                     or (math.isnan(diff) and not math.isnan(dev.max_abs)))
-            if worse:
+            compared = dev.compared = dev.compared + 1
+            worst = dev.max_abs
+            if compared == 1 or diff > worst or (diff != diff and worst == worst):
                 dev.max_abs, dev.at_s, dev.replayed, dev.recorded = diff, t_ns * 1e-9, mine, value
 
 

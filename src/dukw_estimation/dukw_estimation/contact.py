@@ -24,12 +24,19 @@ from dukw_estimation.settings import EkfSettings
 MAX_IMU_STEP_S = 0.1             # IMU gaps longer than this do not feed the heave integral
 SLOPE_FRACTION = 0.9             # above this share the pitch is the beach's, not the waves'
 TOUCHDOWN_SHARE = 0.8           # afloat until the mean-surface volume drops below this share
+#: hull volumes remembered by their inputs (one sample asks for the same volume several
+#: times: the contact decision, the traction output, the force update's prediction)
+VOLUME_CACHE_SIZE = 16
+DRY_MARGIN_M = 1e-6              # the surface this far below the hulls' bottom line: no volume
+# plain ints for the hot paths (indexing numpy with IntEnum members is slower)
+_YAW, _U, _R, _S, _ETA = int(Idx.YAW), int(Idx.U), int(Idx.R), int(Idx.S), int(Idx.ETA)
 
 
 def ground_speeds(x: np.ndarray, hull_separation_m: float) -> tuple[float, float]:
     """Ground speed under the port and starboard tracks, m/s, from the filter's state."""
     half = 0.5 * hull_separation_m
-    return x[Idx.U] - x[Idx.R] * half, x[Idx.U] + x[Idx.R] * half
+    u, r = x[_U], x[_R]
+    return u - r * half, u + r * half
 
 
 class ContactModel:
@@ -52,6 +59,11 @@ class ContactModel:
         # the IMU says
         self.sure_float_m3 = 0.5 * (body.displaced_volume_m3 + self.max_volume_m3)
         self.track_area_m2 = body.track_width_m * body.track_contact_length_m
+        # (waterline distance, surface, heading cos, slope) -> grounded volume, m^3; and the
+        # last submersion's inputs and (h2, volume)
+        self._volumes: dict[tuple[float, ...], float] = {}
+        self._submersion: tuple[tuple[float, ...], tuple[float, float]] | None = None
+        self._cos_slope = (math.nan, math.nan)    # (slope, its cos), rad
         # the heave mass and damping of the hulls' section about the float line (the simulator's)
         heave = heave_constants(body, settings.heave_natural_hz, settings.heave_damping_ratio)
         self.heave_mass_kg = heave.mass_kg
@@ -144,38 +156,80 @@ class ContactModel:
         st = self.settings
         if st.contact_track_force_n <= 0.0 or tracks is None or not tracks_fresh:
             return False
-        return all(abs(self.measured_soil_force_n(tracks, k)) >= st.contact_track_force_n
-                   for k in range(2))
+        limit = st.contact_track_force_n
+        return (abs(self.measured_soil_force_n(tracks, 0)) >= limit
+                and abs(self.measured_soil_force_n(tracks, 1)) >= limit)
 
     # ------------------------------------------------------------------ submersion
     def submersion(self, x: np.ndarray) -> tuple[float, float]:
         """(h2, the volume the estimated surface puts under water on the slope), m, m^3."""
+        waterline, eta = x[_S], x[_ETA]
+        heading_cos = math.cos(x[_YAW] - self.settings.seaward_yaw_rad)
+        key = (waterline, eta, heading_cos, self.slope_rad)
+        last = self._submersion
+        if last is not None and last[0] == key:
+            return last[1]
         body = self.vehicle.body
-        heading_cos = math.cos(x[Idx.YAW] - self.settings.seaward_yaw_rad)
-        args = (x[Idx.S], self.slope_rad, body.hull_clearance_m, self.hull_bow_x_m,
-                self.hull_stern_x_m)
-        h2 = buoyancy.submerged_length_m(*args, x[Idx.ETA], heading_cos)
-        volume = buoyancy.grounded_volume_m3(*args, body.hull_radius_m, x[Idx.ETA], heading_cos,
-                                             self.section)
-        return h2, volume
+        h2 = buoyancy.submerged_length_m(waterline, self.slope_rad, body.hull_clearance_m,
+                                         self.hull_bow_x_m, self.hull_stern_x_m, eta,
+                                         heading_cos)
+        value = (h2, self.grounded_volume_m3(waterline, eta, heading_cos))
+        self._submersion = (key, value)
+        return value
+
+    def grounded_volume_m3(self, waterline_distance_m: float, surface_m: float,
+                           heading_cos: float) -> float:
+        """The hulls' volume under the surface ``surface_m`` with the waterline this far,
+        on the estimated slope, m^3 (``buoyancy.grounded_volume_m3``, remembered by its
+        inputs: the same value, computed once)."""
+        key = (waterline_distance_m, surface_m, heading_cos, self.slope_rad)
+        volumes = self._volumes
+        volume = volumes.get(key)
+        if volume is None:
+            if len(volumes) >= VOLUME_CACHE_SIZE:
+                volumes.clear()
+            body = self.vehicle.body
+            if self._dry(waterline_distance_m, surface_m, heading_cos):
+                volume = volumes[key] = 0.0
+            else:
+                volume = volumes[key] = buoyancy.grounded_volume_m3(
+                    waterline_distance_m, self.slope_rad, body.hull_clearance_m,
+                    self.hull_bow_x_m, self.hull_stern_x_m, body.hull_radius_m, surface_m,
+                    heading_cos, self.section)
+        return volume
+
+    def _dry(self, waterline_distance_m: float, surface_m: float, heading_cos: float) -> bool:
+        """The surface clearly (``DRY_MARGIN_M``) below both ends of the hulls' bottom line:
+        ``buoyancy.grounded_volume_m3`` would integrate nothing and return 0.0 (on the sand,
+        most samples); computed with its own bottom line."""
+        depth0, gradient = buoyancy._bottom_depth_line(   # noqa: SLF001 - the same line
+            waterline_distance_m, self.slope_rad, self.vehicle.body.hull_clearance_m,
+            surface_m, heading_cos)
+        deepest = max(depth0 + gradient * self.hull_bow_x_m,
+                      depth0 + gradient * self.hull_stern_x_m)
+        return deepest < -DRY_MARGIN_M
 
     def surface_volume_m3(self, x: np.ndarray, raise_m: float = 0.0) -> float:
         """The volume under a surface ``raise_m`` above the estimated one, m^3 (0: dry)."""
-        body = self.vehicle.body
-        heading_cos = math.cos(x[Idx.YAW] - self.settings.seaward_yaw_rad)
-        return buoyancy.grounded_volume_m3(x[Idx.S], self.slope_rad, body.hull_clearance_m,
-                                           self.hull_bow_x_m, self.hull_stern_x_m,
-                                           body.hull_radius_m, x[Idx.ETA] + raise_m,
-                                           heading_cos, self.section)
+        heading_cos = math.cos(x[_YAW] - self.settings.seaward_yaw_rad)
+        return self.grounded_volume_m3(x[_S], x[_ETA] + raise_m, heading_cos)
 
     def weight_n(self, grounded_volume_m3: float, afloat: bool) -> float:
         """Weight on the tracks, N: none afloat; on the sand the hulls do not float."""
-        body = self.vehicle.body
         if afloat:
             return 0.0
-        return traction.effective_weight_n(
-            body.displacement_n, min(grounded_volume_m3, body.displaced_volume_m3),
-            self.slope_rad, body.water_density_kgpm3, body.gravity_mps2)
+        return self._effective_weight_n(min(grounded_volume_m3,
+                                            self.vehicle.body.displaced_volume_m3))
+
+    def _effective_weight_n(self, volume_m3: float) -> float:
+        """``traction.effective_weight_n`` on the estimated slope for one volume, written
+        for a scalar (the same operations in the same order: the same bits; numpy's cos of
+        the slope, remembered while the slope stays)."""
+        body = self.vehicle.body
+        if self._cos_slope[0] != self.slope_rad:
+            self._cos_slope = (self.slope_rad, float(np.cos(self.slope_rad)))
+        buoyancy_n = body.water_density_kgpm3 * body.gravity_mps2 * float(volume_m3)
+        return max(body.displacement_n - buoyancy_n, 0.0) * self._cos_slope[1]
 
     def fraction_of(self, weight_n: float) -> float:
         """The share of the weight (along the slope's normal) the tracks carry."""
@@ -225,15 +279,9 @@ class ContactModel:
         """Soil force on the vehicle from one track at these speeds, with the weight the
         surface leaves it, N (heading from ``x``)."""
         body = self.vehicle.body
-        heading_cos = math.cos(x[Idx.YAW] - self.settings.seaward_yaw_rad)
-        volume = buoyancy.grounded_volume_m3(waterline_distance_m, self.slope_rad,
-                                             body.hull_clearance_m, self.hull_bow_x_m,
-                                             self.hull_stern_x_m, body.hull_radius_m,
-                                             surface_m, heading_cos, self.section)
-        weight = traction.effective_weight_n(body.displacement_n,
-                                             min(volume, body.displaced_volume_m3),
-                                             self.slope_rad, body.water_density_kgpm3,
-                                             body.gravity_mps2)
+        heading_cos = math.cos(x[_YAW] - self.settings.seaward_yaw_rad)
+        volume = self.grounded_volume_m3(waterline_distance_m, surface_m, heading_cos)
+        weight = self._effective_weight_n(min(volume, body.displaced_volume_m3))
         return self.track_force_n(track_mps, ground_mps, 0.5 * weight,
                                   self.saturation(waterline_distance_m, surface_m, heading_cos))
 

@@ -61,7 +61,7 @@ class Outcome(Enum):
     IGNORED = 'ignored'          # disabled sensor, no fix, nothing to learn
 
 
-@dataclass
+@dataclass(frozen=True)
 class ProcessNoise:
     """Continuous-time process noise densities (sigma per sqrt(s)) and the wave model."""
 
@@ -93,6 +93,9 @@ class MotionEkf:
         self.noise = noise
         self.seaward_yaw_rad = seaward_yaw_rad
         self._eye = np.eye(N_STATES)
+        # process noise variance rates (diagonal of Q / dt) by acceleration noise: the noise
+        # is frozen, and the predictions use one or two acceleration noises
+        self._q_rates: dict[float, np.ndarray] = {}
 
     def predict(self, dt: float, accel_body: tuple[float, float] | None = None,
                 drive_target: tuple[float, float, float] | None = None,
@@ -148,14 +151,21 @@ class MotionEkf:
         x[_GBE] *= decay
         x[_GBN] *= decay
         F[_GBE, _GBE] = F[_GBN, _GBN] = decay
-        bias_q = 2.0 * n.gps_bias_sigma_m ** 2 / n.gps_bias_tau_s
         accel = n.accel_mps2 if accel_noise_mps2 is None else accel_noise_mps2
-        q = np.array([n.position_m ** 2, n.position_m ** 2, n.yaw_rad ** 2, accel ** 2,
-                      accel ** 2, n.yaw_accel_rps2 ** 2, n.gyro_bias_rps ** 2,
-                      n.waterline_m ** 2, 0.0, n.wave_drive(), bias_q, bias_q]) * dt
+        q_rate = self._q_rates.get(accel)
+        if q_rate is None:
+            q_rate = self._q_rates[accel] = self._q_rate(accel)
         P = F @ self.P @ F.T
-        P[np.diag_indices(N_STATES)] += q
+        P.reshape(-1)[::N_STATES + 1] += q_rate * dt     # the diagonal (a view of P)
         self.P = P
+
+    def _q_rate(self, accel_mps2: float) -> np.ndarray:
+        """The diagonal of the process noise per second with this acceleration noise."""
+        n = self.noise
+        bias_q = 2.0 * n.gps_bias_sigma_m ** 2 / n.gps_bias_tau_s
+        return np.array([n.position_m ** 2, n.position_m ** 2, n.yaw_rad ** 2, accel_mps2 ** 2,
+                         accel_mps2 ** 2, n.yaw_accel_rps2 ** 2, n.gyro_bias_rps ** 2,
+                         n.waterline_m ** 2, 0.0, n.wave_drive(), bias_q, bias_q])
 
     def update(self, z: np.ndarray, hx: np.ndarray, H: np.ndarray, R: np.ndarray,
                gate: float, angle_rows: tuple[int, ...] = ()) -> Outcome:
@@ -167,6 +177,8 @@ class MotionEkf:
             y[row] = wrap_angle(y[row])
         PHt = self.P @ H.T
         S = H @ PHt + R
+        if S.shape == (2, 2) and R[0, 1] == 0.0 and R[1, 0] == 0.0:
+            return self._update_rows_2d(y, H, R, S, gate)
         try:
             S_inv = np.linalg.inv(S)
         except np.linalg.LinAlgError:
@@ -186,6 +198,26 @@ class MotionEkf:
         self.x[_YAW] = wrap_angle(self.x[_YAW])
         I_KH = self._eye - K @ H
         self.P = I_KH @ self.P @ I_KH.T + K @ R @ K.T
+        return Outcome.ACCEPTED
+
+    def _update_rows_2d(self, y: np.ndarray, H: np.ndarray, R: np.ndarray, S: np.ndarray,
+                        gate: float) -> Outcome:
+        """``update`` of a 2-D measurement with a diagonal R (the DGPS's, the tracks'): the
+        gate's Mahalanobis distance from the 2x2 inverse in closed form (a singular S is
+        rejected, as ``inv`` would), then the two rows in turn."""
+        a, b, c, d = float(S[0, 0]), float(S[0, 1]), float(S[1, 0]), float(S[1, 1])
+        det = a * d - b * c
+        if det == 0.0:
+            return Outcome.REJECTED_OUTLIER
+        y0, y1 = float(y[0]), float(y[1])
+        d2 = (y0 * (d * y0 - b * y1) + y1 * (a * y1 - c * y0)) / det
+        if not math.isfinite(d2) or d2 > gate * gate:
+            return Outcome.REJECTED_OUTLIER
+        x_start = self.x.copy()
+        self.update_scalar(y0, 0.0, H[0], float(R[0, 0]), math.inf)
+        # the second row's residual moves with the state the first row corrected
+        residual = y[1] - float(H[1] @ (self.x - x_start))
+        self.update_scalar(residual, 0.0, H[1], float(R[1, 1]), math.inf)
         return Outcome.ACCEPTED
 
     def update_scalar(self, z: float, hx: float, h: np.ndarray, var: float,

@@ -1,14 +1,20 @@
 """Kalman smoothing of a measured track force (current x gain), as the paper did before fitting.
 
-A constant-velocity model [force, force rate] in filterpy's linear KalmanFilter.
+A constant-velocity model [force, force rate] in filterpy's linear KalmanFilter (its state,
+covariance and matrices). The predict and update are filterpy's equations written out with
+the same numpy products in the same order (the results are bit-identical): its generic
+calls cost more than the track-force step can afford (scipy's block_diag in
+``Q_discrete_white_noise``, a deepcopy and a 1x1 ``inv`` per update; issue 16).
 """
 from __future__ import annotations
 
 import math
 
 import numpy as np
-from filterpy.common import Q_discrete_white_noise
 from filterpy.kalman import KalmanFilter
+
+
+_EYE2 = np.eye(2)
 
 
 class ForceSmoother:
@@ -42,9 +48,30 @@ class ForceSmoother:
         if dt < 0.0:
             return False
         if dt > 0.0:
-            self.kf.F = np.array([[1.0, dt], [0.0, 1.0]])
-            self.kf.Q = Q_discrete_white_noise(2, dt, self.process_n_per_s ** 2)
-            self.kf.predict()
-        self.kf.update(np.array([[force_n]]))
+            self._predict(dt)
+        self._update(force_n)
         self.t_s = t_s
         return True
+
+    def _predict(self, dt: float) -> None:
+        """filterpy's KalmanFilter.predict with F = [[1, dt], [0, 1]] and the discrete white
+        noise Q of ``Q_discrete_white_noise(2, dt, process ** 2)``."""
+        kf = self.kf
+        kf.F = F = np.array([[1.0, dt], [0.0, 1.0]])
+        kf.Q = Q = np.array([[.25 * dt ** 4, .5 * dt ** 3],
+                             [.5 * dt ** 3, dt ** 2]]) * self.process_n_per_s ** 2
+        kf.x = np.dot(F, kf.x)
+        kf.P = np.dot(np.dot(F, kf.P), F.T) + Q
+
+    def _update(self, force_n: float) -> None:
+        """filterpy's KalmanFilter.update (Joseph form) for the one scalar measurement; the
+        1x1 innovation covariance is inverted by a division, as LAPACK does it."""
+        kf = self.kf
+        H, R, P = kf.H, kf.R, kf.P
+        y = np.array([[force_n]]) - np.dot(H, kf.x)
+        PHT = np.dot(P, H.T)
+        S = np.dot(H, PHT) + R
+        K = np.dot(PHT, 1.0 / S)
+        kf.x = kf.x + np.dot(K, y)
+        I_KH = _EYE2 - np.dot(K, H)
+        kf.P = np.dot(np.dot(I_KH, P), I_KH.T) + np.dot(np.dot(K, R), K.T)

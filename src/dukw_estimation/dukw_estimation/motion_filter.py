@@ -30,10 +30,24 @@ GROUNDED_FRACTION = 0.5          # above this weight share the tracks drive the 
 #: filter does not estimate is fixed; the rest is copied from P with precomputed indices
 _POSE_COV_BASE = np.diag([0.0, 0.0, 1e3, 1e-2, 1e-2, 0.0])
 _TWIST_COV_BASE = np.diag([0.0, 0.0, 1e3, 1e3, 1e3, 0.0])
-_POSE_AT = np.ix_([0, 1, 5], [0, 1, 5])
-_POSE_FROM = np.ix_([Idx.X, Idx.Y, Idx.YAW], [Idx.X, Idx.Y, Idx.YAW])
-_TWIST_AT = np.ix_([0, 1], [0, 1])
-_TWIST_FROM = np.ix_([Idx.U, Idx.V], [Idx.U, Idx.V])
+#: (row, column in the message's covariance, row, column in P): x, y, yaw -> x, y, yaw;
+#: u, v -> vx, vy; r -> wz (no u, v - r terms). Element by element: fancy indexing costs
+#: more than these few items
+_POSE_MAP = ((0, Idx.X), (1, Idx.Y), (5, Idx.YAW))
+_TWIST_MAP = ((0, Idx.U), (1, Idx.V))
+_POSE_COPY = tuple((a, b, int(i), int(j)) for a, i in _POSE_MAP for b, j in _POSE_MAP)
+_TWIST_COPY = tuple((a, b, int(i), int(j)) for a, i in _TWIST_MAP
+                    for b, j in _TWIST_MAP) + ((5, 5, int(Idx.R), int(Idx.R)),)
+_X, _Y, _YAW, _U, _V, _R, _S = (int(Idx.X), int(Idx.Y), int(Idx.YAW), int(Idx.U), int(Idx.V),
+                                int(Idx.R), int(Idx.S))
+_BIAS = int(Idx.BIAS)
+#: the IMU's measurement rows (read only): the gyro's z rate r + bias, the heading yaw
+_H_GYRO = np.zeros(N_STATES)
+_H_GYRO[[_R, _BIAS]] = 1.0
+_H_GYRO.flags.writeable = False
+_H_YAW = np.zeros(N_STATES)
+_H_YAW[_YAW] = 1.0
+_H_YAW.flags.writeable = False
 
 class MotionFilter:
     """Pose, twist, gyro bias and GPS bias of base_link in odom (and the EKF's time)."""
@@ -160,19 +174,16 @@ class MotionFilter:
         self.accel_base = self._accel_at_base_link(s, dt)
         self.imu = s
         st = self.settings
-        h = np.zeros(N_STATES)
-        h[Idx.R] = h[Idx.BIAS] = 1.0
         var = s.yaw_rate_var_rps2 if s.yaw_rate_var_rps2 > 0 else st.gyro_rps ** 2
-        out = self.ekf.update_scalar(s.yaw_rate_rps, self.ekf.x[Idx.R] + self.ekf.x[Idx.BIAS],
-                                     h, var, st.gate_imu)
+        x = self.ekf.x
+        out = self.ekf.update_scalar(s.yaw_rate_rps, x[_R] + x[_BIAS], _H_GYRO, var,
+                                     st.gate_imu)
         if math.isfinite(s.yaw_rad):
             if not self.yaw_set:
                 self.ekf.x[Idx.YAW] = wrap_angle(s.yaw_rad)
                 self.yaw_set = True
-            h = np.zeros(N_STATES)
-            h[Idx.YAW] = 1.0
             var = s.yaw_var_rad2 if s.yaw_var_rad2 > 0 else st.yaw_rad ** 2
-            yaw_out = self.ekf.update_scalar(s.yaw_rad, self.ekf.x[Idx.YAW], h, var,
+            yaw_out = self.ekf.update_scalar(s.yaw_rad, self.ekf.x[_YAW], _H_YAW, var,
                                              st.gate_imu, angle=True)
             if yaw_out is not Outcome.ACCEPTED:
                 out = yaw_out
@@ -266,14 +277,16 @@ class MotionFilter:
     def odometry(self, slope_rad: float) -> OdometryEstimate:
         """Pose and twist of base_link in odom with covariances (z on the slope)."""
         x, P = self.ekf.x, self.ekf.P
-        roll = self.imu.roll_rad if self.imu else 0.0
-        pitch = self.imu.pitch_rad if self.imu else 0.0
+        imu = self.imu
+        roll = imu.roll_rad if imu else 0.0
+        pitch = imu.pitch_rad if imu else 0.0
         pose_cov = _POSE_COV_BASE.copy()
-        pose_cov[_POSE_AT] = P[_POSE_FROM]          # x, y, yaw of the filter -> x, y, yaw
+        for a, b, i, j in _POSE_COPY:
+            pose_cov[a, b] = P[i, j]
         twist_cov = _TWIST_COV_BASE.copy()
-        twist_cov[_TWIST_AT] = P[_TWIST_FROM]       # u, v -> vx, vy
-        twist_cov[5, 5] = P[Idx.R, Idx.R]           # r -> wz (no u, v - r terms)
-        z = -x[Idx.S] * math.sin(slope_rad)
-        return OdometryEstimate(self.t_s or 0.0, float(x[Idx.X]), float(x[Idx.Y]), z, roll,
-                                pitch, float(x[Idx.YAW]), float(x[Idx.U]), float(x[Idx.V]),
-                                float(x[Idx.R]), pose_cov, twist_cov)
+        for a, b, i, j in _TWIST_COPY:
+            twist_cov[a, b] = P[i, j]
+        z = -x[_S] * math.sin(slope_rad)
+        return OdometryEstimate(self.t_s or 0.0, float(x[_X]), float(x[_Y]), z, roll,
+                                pitch, float(x[_YAW]), float(x[_U]), float(x[_V]),
+                                float(x[_R]), pose_cov, twist_cov)
