@@ -37,7 +37,7 @@ class SurfaceObserver:
         """Forget when the tracks touched down and when their forces were last used."""
         self.grounded_since_s = math.inf
         self.force_update_t_s = -math.inf
-        self.dry_sensors: tuple[tuple[float, float], ...] = ()   # (x, z) of sensors read dry
+        self.dry_sensors: tuple[tuple[float, float], ...] = ()   # (x, z): both read dry
         self.dry_t_s = -math.inf                                 # ... at this time
 
     # ------------------------------------------------------------------ wet / dry
@@ -62,13 +62,16 @@ class SurfaceObserver:
         if out is Outcome.IGNORED:
             out = Outcome.ACCEPTED    # consistent with the state: nothing to correct
         if self.settings.water_dry_bound:
-            self.dry_sensors = tuple((x_m, z_m) for wet, x_m, z_m in sensors if not wet)
+            both_dry = not (s.fore_wet or s.aft_wet)
+            self.dry_sensors = tuple((x_m, z_m) for _, x_m, z_m in sensors) if both_dry else ()
             self.dry_t_s = s.t_s
             self.bound_by_dry_sensors(ekf, s.t_s)
         return out
 
     def bound_by_dry_sensors(self, ekf: MotionEkf, t_s: float) -> None:
-        """The sensors last read dry (fresh, on the sand) put the surface below them: where
+        """Both sensors last read dry (fresh, on the sand): the surface is below both (the
+        hulls out of the water; one sensor dry under a wave's crest between them says less,
+        and its debounced flag lags a rising surface: left to the gated update). Where
         the state has water over one, project the surface states onto its bound (the
         covariance-weighted least change, Simon 2010, Kalman filtering with state
         constraints; the covariance is left as it is)."""

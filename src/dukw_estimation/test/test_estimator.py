@@ -534,3 +534,33 @@ def test_the_surface_observer_uses_the_saturated_sands_strength_where_water_cove
                                          VEHICLE.body.track_contact_length_m))
     assert contact.track_force_n(1.2, 0.4, 1000.0, 0.0) == plain
     assert contact.track_force_n(1.2, 0.4, 1000.0, 1.0) > plain
+
+
+class _DrySensors(Estimator):
+    """Both water sensors read dry with every track status (the hulls out of the water)."""
+
+    def add_tracks(self, s):
+        out = super().add_tracks(s)
+        self.add_water_contact(WaterContact(s.t_s, False, False))
+        return out
+
+
+def test_dry_water_sensors_bound_the_surface_that_a_wrong_soil_pushes_up():
+    """On the beach with both sensors dry, a soil stronger than the site's reads the track
+    forces as water under the hulls. Gated, the dry readings lose to the confident force
+    updates; as a bound (contact.dry_bound) they keep the volume under what a surface at
+    the lower sensor puts under water (1.73 % of the displacement on 4.5 deg)."""
+    strong = dataclasses.replace(soil_params(PARAMS), friction_angle_rad=0.26,
+                                 shear_modulus_m=0.02)
+
+    def volume_share(dry_bound):
+        settings = dataclasses.replace(SETTINGS, wave_sigma_m=0.07, waterline_sigma_m=0.05,
+                                       soil_online_enabled=False, water_dry_bound=dry_bound)
+        est = _DrySensors(VEHICLE, settings, strong)
+        est.ekf.x[Idx.ETA] = 0.15                         # starting from water over the hulls
+        truth = _surf_run(est, 0.0, 0.4, seconds=3.0, x0=0.5)
+        assert truth == pytest.approx(1.0)                  # the hulls are out
+        return est.traction().submerged_volume_m3 / VEHICLE.body.displaced_volume_m3
+
+    assert volume_share(False) > 0.05
+    assert volume_share(True) <= 0.0175
