@@ -192,8 +192,9 @@ class Estimator:
 
     def _learn_soil(self, s: DriveStatus) -> None:
         """On dry sand (no hull volume and no water over the tracks' patches even with the
-        surface ``soil_online.dry_margin_m`` higher: saturated sand is stronger) each slipping track's soil force at the known weight updates the site's
-        soil, which the contact model then uses."""
+        surface ``soil_online.dry_margin_m`` higher: saturated sand is stronger) each
+        slipping track's soil force at the known weight updates the site's soil, which the
+        contact model then uses."""
         online, contact, st = self.online_soil, self.contact, self.settings
         x, P, margin = self.ekf.x, self.ekf.P, st.soil_online_dry_margin_m
         if not (st.soil_online_enabled and online.due(s.t_s)) or contact.afloat \
