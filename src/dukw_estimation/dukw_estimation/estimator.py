@@ -191,15 +191,18 @@ class Estimator:
         return self._settle('tracks', Outcome.ACCEPTED)
 
     def _learn_soil(self, s: DriveStatus) -> None:
-        """On dry sand (no hull volume even with the surface ``soil_online.dry_margin_m``
-        higher) each slipping track's soil force at the known weight updates the site's
-        soil, which the contact model then uses."""
+        """On dry sand (no hull volume and no water over the tracks' patches even with the
+        surface ``soil_online.dry_margin_m`` higher: saturated sand is stronger) each
+        slipping track's soil force at the known weight updates the site's soil, which the
+        contact model then uses."""
         online, contact, st = self.online_soil, self.contact, self.settings
+        x, P, margin = self.ekf.x, self.ekf.P, st.soil_online_dry_margin_m
         if not (st.soil_online_enabled and online.due(s.t_s)) or contact.afloat \
-                or contact.surface_volume_m3(self.ekf.x, st.soil_online_dry_margin_m) > 0.0:
-            return
+                or contact.surface_volume_m3(x, margin) > 0.0 or contact.saturation(
+                    x[Idx.S], x[Idx.ETA] + margin,
+                    math.cos(x[Idx.YAW] - st.seaward_yaw_rad)) > 0.0:
+            return                   # water over the hulls or the tracks' patches
         body = self.vehicle.body
-        x, P = self.ekf.x, self.ekf.P
         ground = ground_speeds(x, body.hull_separation_m)
         weight = 0.5 * contact.weight_n(0.0, False)
         learnt = False

@@ -164,6 +164,10 @@ class EkfSettings:
         'force_update.max_slip_spread', "no force update where the ground speed's uncertainty "
         "moves the model's force by more than this share of it (a small slip on a soft "
         'soil: the force then tells the slip, not the water; 0: off)', 0, 10)
+    water_dry_bound: bool = _f(
+        'contact.dry_bound', 'both water sensors reading dry bound the surface below them: '
+        'the surface states are projected onto that bound (a constraint, which confident '
+        'track-force updates cannot outvote as they do a gated measurement)')
     soil_preset: str = _f('soil_preset', "soil preset name; '' uses soil.*")
     # the site's soil learnt online on dry sand (soil_online.py)
     soil_online_enabled: bool = _f('soil_online.enabled', 'learn phi and k of the site from '

@@ -37,17 +37,21 @@ class SurfaceObserver:
         """Forget when the tracks touched down and when their forces were last used."""
         self.grounded_since_s = math.inf
         self.force_update_t_s = -math.inf
+        self.dry_sensors: tuple[tuple[float, float], ...] = ()   # (x, z): both read dry
+        self.dry_t_s = -math.inf                                 # ... at this time
 
     # ------------------------------------------------------------------ wet / dry
     def water_contact(self, ekf: MotionEkf, s: WaterContact) -> Outcome:
         """Wet/dry sensors: where the state disagrees, the surface is at the sensor."""
+        self.dry_sensors = ()
         if self.contact.afloat:
             # floating, the sensors ride with the hull, not at a height above the sand
             return Outcome.ACCEPTED
         mounts = self.vehicle.sensors
+        sensors = ((s.fore_wet, mounts.fore_water_x_m, mounts.fore_water_z_m),
+                   (s.aft_wet, mounts.aft_water_x_m, mounts.aft_water_z_m))
         out = Outcome.IGNORED
-        for wet, x_m, z_m in ((s.fore_wet, mounts.fore_water_x_m, mounts.fore_water_z_m),
-                              (s.aft_wet, mounts.aft_water_x_m, mounts.aft_water_z_m)):
+        for wet, x_m, z_m in sensors:
             depth, h = self._sensor_depth(ekf.x, x_m, z_m)
             if bool(wet) == (depth > 0.0):
                 continue
@@ -57,7 +61,31 @@ class SurfaceObserver:
                 out = result
         if out is Outcome.IGNORED:
             out = Outcome.ACCEPTED    # consistent with the state: nothing to correct
+        if self.settings.water_dry_bound:
+            both_dry = not (s.fore_wet or s.aft_wet)
+            self.dry_sensors = tuple((x_m, z_m) for _, x_m, z_m in sensors) if both_dry else ()
+            self.dry_t_s = s.t_s
+            self.bound_by_dry_sensors(ekf, s.t_s)
         return out
+
+    def bound_by_dry_sensors(self, ekf: MotionEkf, t_s: float) -> None:
+        """Both sensors last read dry (fresh, on the sand): the surface is below both (the
+        hulls out of the water; one sensor dry under a wave's crest between them says less,
+        and its debounced flag lags a rising surface: left to the gated update). Where
+        the state has water over one, project the surface states onto its bound (the
+        covariance-weighted least change, Simon 2010, Kalman filtering with state
+        constraints; the covariance is left as it is)."""
+        if self.contact.afloat or t_s - self.dry_t_s > self.settings.sensor_timeout_s:
+            return
+        for x_m, z_m in self.dry_sensors:
+            depth, h = self._sensor_depth(ekf.x, x_m, z_m)
+            if depth <= 0.0:
+                continue
+            h_surface = h * SURFACE_STATES
+            p_h = ekf.P @ h_surface
+            spread = float(h_surface @ p_h)
+            if spread > 0.0:
+                ekf.x -= SURFACE_STATES * p_h * (depth / spread)
 
     def _sensor_depth(self, x: np.ndarray, x_m: float, z_m: float) -> tuple[float, np.ndarray]:
         """Water over a sensor at body (x, z) of a vehicle on the slope, and its Jacobian."""
@@ -111,6 +139,7 @@ class SurfaceObserver:
         self.force_update_t_s = s.t_s
         for k in range(2):
             self._track_force_update(ekf, k, measured[k], speeds[k], ground[k])
+        self.bound_by_dry_sensors(ekf, s.t_s)
 
     def _force_update_due(self, t_s: float) -> bool:
         st = self.settings

@@ -16,6 +16,7 @@ from dukw_estimation.force_filter import ForceSmoother
 from dukw_common.readings import (DepthReading, DriveStatus, GpsFix, GpsVelocity, ImuSample,
                                   MotorSide, WaterContact)
 from dukw_estimation.settings import EkfSettings
+from dukw_estimation.surface import SurfaceObserver
 
 PARAMS = node_params('ekf_node')
 SETTINGS = EkfSettings.from_params(PARAMS)
@@ -368,10 +369,20 @@ def test_track_forces_are_not_used_at_low_slip():
         deaf.traction().weight_on_tracks_fraction, abs=1e-9)
 
 
-def test_track_forces_whose_slip_is_too_uncertain_are_not_used():
+def test_track_forces_whose_slip_is_too_uncertain_are_not_used(monkeypatch):
     """force_update.max_slip_spread: where the ground speed's uncertainty moves the model's
     force by more than that share, the force tells the slip rather than the water."""
+    used_updates = []
+    update = SurfaceObserver._track_force_update
+
+    def counted(self, ekf, *args):
+        before = ekf.x.copy()
+        update(self, ekf, *args)
+        used_updates[-1] += int(np.any(ekf.x != before))
+    monkeypatch.setattr(SurfaceObserver, '_track_force_update', counted)
+
     def fraction(**changes):
+        used_updates.append(0)
         est = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, soil_online_enabled=False,
                    **changes)
         _surf_run(est, -0.06, 0.4)
@@ -380,9 +391,12 @@ def test_track_forces_whose_slip_is_too_uncertain_are_not_used():
     assert abs(used - deaf) > 0.1
     # slipping 0.4, the ground speed's error hardly moves the force: used as without the gate
     assert fraction(force_update_max_slip_spread=0.2) == pytest.approx(used, abs=1e-9)
-    # a gate tighter than any force's spread keeps most of them out (0.32 of the forces' pull
-    # gets through since the saturated sand's suction, issue 13; 0.3 was the bound before)
-    assert abs(fraction(force_update_max_slip_spread=1e-4) - deaf) < 0.5 * abs(used - deaf)
+    # a gate tighter than any force's spread keeps them out, but for a hull thought afloat
+    # (the model's force nil, so is its change with the slip: the surface's secant decides;
+    # on the surf physics that one update moves the share by a third of all of them)
+    fraction(force_update_max_slip_spread=1e-4)
+    assert used_updates[1] == used_updates[2] > 50
+    assert used_updates[3] <= 2
 
 
 def test_track_forces_of_nearly_stopped_tracks_are_not_used():
@@ -535,3 +549,33 @@ def test_the_surface_observer_uses_the_saturated_sands_strength_where_water_cove
                                          VEHICLE.body.track_contact_length_m))
     assert contact.track_force_n(1.2, 0.4, 1000.0, 0.0) == plain
     assert contact.track_force_n(1.2, 0.4, 1000.0, 1.0) > plain
+
+
+class _DrySensors(Estimator):
+    """Both water sensors read dry with every track status (the hulls out of the water)."""
+
+    def add_tracks(self, s):
+        out = super().add_tracks(s)
+        self.add_water_contact(WaterContact(s.t_s, False, False))
+        return out
+
+
+def test_dry_water_sensors_bound_the_surface_that_a_wrong_soil_pushes_up():
+    """On the beach with both sensors dry, a soil stronger than the site's reads the track
+    forces as water under the hulls. Gated, the dry readings lose to the confident force
+    updates; as a bound (contact.dry_bound) they keep the volume under what a surface at
+    the lower sensor puts under water (1.73 % of the displacement on 4.5 deg)."""
+    strong = dataclasses.replace(soil_params(PARAMS), friction_angle_rad=0.26,
+                                 shear_modulus_m=0.02)
+
+    def volume_share(dry_bound):
+        settings = dataclasses.replace(SETTINGS, wave_sigma_m=0.07, waterline_sigma_m=0.05,
+                                       soil_online_enabled=False, water_dry_bound=dry_bound)
+        est = _DrySensors(VEHICLE, settings, strong)
+        est.ekf.x[Idx.ETA] = 0.15                         # starting from water over the hulls
+        truth = _surf_run(est, 0.0, 0.4, seconds=3.0, x0=0.5)
+        assert truth == pytest.approx(1.0)                  # the hulls are out
+        return est.traction().submerged_volume_m3 / VEHICLE.body.displaced_volume_m3
+
+    assert volume_share(False) > 0.05
+    assert volume_share(True) <= 0.0175
