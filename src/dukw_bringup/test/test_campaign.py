@@ -228,8 +228,11 @@ def test_a_run_on_dry_sand_learns_the_drawn_soil_online():
     cond = dict(campaign.draw_conditions(spec, 0), kind='land_to_sea', beach_slope_deg=3.26,
                 significant_wave_height_m=0.0, soil_preset='', cohesion_kpa=0.111,
                 friction_angle_deg=5.81, shear_modulus_cm=11.15, speed_mps=0.92,
-                start_offset_m=0.35, gps_dropout=False, gps_outlier=False)
+                start_offset_m=-4.0, gps_dropout=False, gps_outlier=False)
     cond['sim.physics.dt_s'] = 0.01
+    # the drawn soil from 7 m above the waterline (the default wet sand starts 1 m above it),
+    # so that the run has 5 s on it with no water over the tracks, where the estimator learns
+    cond['sim.world.wet_sand_start_x_m'] = -7.0
     loop = campaign.build_loop(spec, cond)
     prior, body = loop.est.online_soil.prior, loop.est.vehicle.body
     slips = []
