@@ -18,7 +18,7 @@ from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
 from dukw_bringup import live_foxglove as fg
-from dukw_bringup.live_forward import GraphForwarder
+from dukw_bringup.live_forward import GraphForwarder, SubscriberDemand
 from dukw_bringup.live_markers import beach_markers
 from dukw_bringup.live_scene import (TRUTH_ALPHA, LiveScene, SceneArea, sim_world_fields,
                                      site_ground, vehicle_parts)
@@ -61,6 +61,7 @@ class LiveViewNode(Node):
             raise ConfigError(f'live_view_node: {exc}') from exc
         self.parts, self.ghost = vehicle_parts(model), vehicle_parts(model, TRUTH_ALPHA)
         self.current_limit_a = vehicle.drivetrain.continuous_current_limit_a
+        self.demand = SubscriberDemand()      # the clients' subscriptions (server thread)
         self.server = self._start_server(p['host'], int(p['port']))
         self.url = f'ws://{p["host"]}:{self.server.port}'
         self.get_logger().info(f'Foxglove live view: {self.url} (Open connection -> '
@@ -73,7 +74,7 @@ class LiveViewNode(Node):
         self.gps_ch = foxglove.channels.LocationFixChannel('/live/gps')
         self.limits_ch = foxglove.Channel('/live/limits')
         self.forwarder = GraphForwarder(self, taps={self.resolve_topic_name('gps/fix'):
-                                                    self.on_fix})
+                                                    self.on_fix}, demand=self.demand)
         self.create_timer(p['rescan_period_s'], self.forwarder.scan)
         self.create_timer(1.0 / p['water_rate_hz'], self.on_water)
         self.create_timer(p['latched_period_s'], self.on_latched)
@@ -90,10 +91,12 @@ class LiveViewNode(Node):
 
     def _start_server(self, host: str, port: int):
         try:
-            return foxglove.start_server(name='dukw-ling', host=host, port=port)
+            return foxglove.start_server(name='dukw-ling', host=host, port=port,
+                                         server_listener=self.demand)
         except Exception as exc:  # port taken: the view must not stop the stack
             self.get_logger().warning(f'port {port} unusable ({exc}): taking a free one')
-            return foxglove.start_server(name='dukw-ling', host=host, port=0)
+            return foxglove.start_server(name='dukw-ling', host=host, port=0,
+                                         server_listener=self.demand)
 
     def now_ns(self) -> int:
         """Node clock (sim time under use_sim_time), ns."""

@@ -101,3 +101,36 @@ def test_a_websocket_client_gets_the_graph_and_the_scene():
                                   'visualization_msgs/msg/MarkerArray')
     assert [m.ns for m in beach.markers] == ['beach', 'sea_level']
     assert all(m.header.frame_id == 'odom' and len(m.points) % 3 == 0 for m in beach.markers)
+
+
+class _Channel:
+    """What the foxglove server hands its listener: a channel view with its topic."""
+
+    def __init__(self, topic: str) -> None:
+        self.topic = topic
+
+
+def test_a_topic_is_subscribed_only_while_a_viewer_wants_it():
+    """Like foxglove_bridge: no viewer, no ROS subscription on the 100 Hz topics (the stack's
+    CPU); a client's subscription brings it at the next scan, its unsubscription drops it."""
+    from dukw_bringup.live_forward import GraphForwarder, SubscriberDemand
+    with ros_node('live_demand_probe') as (node, executor):
+        pub = node.create_publisher(String, 'live_demand/chatter', 10)
+        demand = SubscriberDemand()
+        forwarder = GraphForwarder(node, demand=demand)
+
+        def subscribers_after_scan() -> int:
+            spin_until(executor, lambda: False, 0.2)
+            forwarder.scan()
+            spin_until(executor, lambda: False, 0.2)
+            return pub.get_subscription_count()
+        assert spin_until(executor, lambda: (forwarder.scan() or True)
+                          and '/live_demand/chatter' in forwarder.channels, 10.0)
+        assert subscribers_after_scan() == 0                 # advertised, not subscribed
+        for client in (1, 2):
+            demand.on_subscribe(client, _Channel('/live_demand/chatter'))
+        assert subscribers_after_scan() == 1                 # one subscription for both
+        demand.on_unsubscribe(1, _Channel('/live_demand/chatter'))
+        assert subscribers_after_scan() == 1                 # the other client still wants it
+        demand.on_unsubscribe(2, _Channel('/live_demand/chatter'))
+        assert subscribers_after_scan() == 0
