@@ -103,6 +103,8 @@ class LiveViewNode(Node):
         return self.get_clock().now().nanoseconds
 
     def on_water(self) -> None:
+        if not self.scene_ch.has_sinks():      # no viewer: no mesh (most of the view's CPU)
+            return
         t_ns = self.now_ns()
         water = self.scene.water(t_ns * 1e-9)
         self.scene_ch.log(fg.scene(fg.mesh_entity(water, self.p['frames.odom'], t_ns)),
@@ -111,12 +113,14 @@ class LiveViewNode(Node):
     def on_latched(self) -> None:
         t_ns = self.now_ns()
         self.forwarder.relog_latched()
+        self.limits_ch.log({'continuous_current_limit_a': self.current_limit_a}, log_time=t_ns)
+        if not self.scene_ch.has_sinks():      # no viewer: no meshes
+            return
         self.scene_ch.log(fg.scene(
             fg.mesh_entity(self.scene.beach(), self.p['frames.odom'], t_ns),
             fg.parts_entity('vehicle', self.parts, self.p['frames.base'], t_ns),
             fg.parts_entity('vehicle_truth', self.ghost, self.p['frames.truth'], t_ns)),
             log_time=t_ns)
-        self.limits_ch.log({'continuous_current_limit_a': self.current_limit_a}, log_time=t_ns)
 
     def on_fix(self, msg) -> None:
         """sensor_msgs/NavSatFix -> LocationFix on the map."""
