@@ -25,6 +25,7 @@ from dukw_model.scalars import is_scalar
 from dukw_common.vehicle import SaturatedSandParams, SoilParams
 
 ArrayLike = float | np.ndarray
+_expm1 = np.expm1          # numpy's (not libm's): the array paths' bits
 
 
 #: No dilatancy hardening: the plain (dry-sand) Wong force. The saturated sand's (van Os 1977;
@@ -57,9 +58,7 @@ def slip(track_speed_mps: ArrayLike, ground_speed_mps: ArrayLike,
     negative slip instead of infinity; the result is clipped to [-1, 1].
     """
     if is_scalar(track_speed_mps) and is_scalar(ground_speed_mps):   # scalar path
-        v_t, v_r = float(track_speed_mps), float(ground_speed_mps)
-        denom = max(abs(v_t), min_track_speed_mps) * (1.0 if v_t >= 0.0 else -1.0)
-        return min(max((v_t - v_r) / denom, -1.0), 1.0)
+        return slip_f(float(track_speed_mps), float(ground_speed_mps), min_track_speed_mps)
     v_t = np.asarray(track_speed_mps, dtype=float)
     v_r = np.asarray(ground_speed_mps, dtype=float)
     sign = np.where(v_t >= 0.0, 1.0, -1.0)
@@ -88,11 +87,7 @@ def shear_development(slip_abs: ArrayLike, contact_length_m: float,
     Safe at |i| -> 0 (series 1 - (1 - x/2) = x/2) and at k -> 0 (-> 1).
     """
     if is_scalar(slip_abs):                                          # scalar path
-        s = abs(float(slip_abs))
-        if shear_modulus_m <= 1e-9:
-            return 1.0 if s > 0.0 else 0.0
-        x = s * contact_length_m / shear_modulus_m
-        return x / 2.0 if x < 1e-6 else 1.0 + float(np.expm1(-x)) / x   # numpy: same bits
+        return _shear_development_f(abs(float(slip_abs)), contact_length_m, shear_modulus_m)
     s = np.abs(np.asarray(slip_abs, dtype=float))
     if shear_modulus_m <= 1e-9:  # k -> 0: shear fully developed at any slip
         out = np.where(s > 0.0, 1.0, 0.0)
@@ -189,6 +184,15 @@ def slip_f(track_speed_mps: float, ground_speed_mps: float,
     return min(max((track_speed_mps - ground_speed_mps) / denom, -1.0), 1.0)
 
 
+def _shear_development_f(slip_abs: float, contact_length_m: float,
+                         shear_modulus_m: float) -> float:
+    """``shear_development`` of one float |i| >= 0."""
+    if shear_modulus_m <= 1e-9:
+        return 1.0 if slip_abs > 0.0 else 0.0
+    x = slip_abs * contact_length_m / shear_modulus_m
+    return x / 2.0 if x < 1e-6 else 1.0 + float(_expm1(-x)) / x   # numpy's expm1: same bits
+
+
 class TrackPatch:
     """One track's contact patch for ``track_force_f``: the arguments of ``track_force_n``
     (weight, soil, area, length, suction, saturation) with tan(phi), the cohesion's share
@@ -232,8 +236,7 @@ def _tan(phi_rad: float) -> float:
 def track_force_f(patch: TrackPatch, track_speed_mps: float, ground_speed_mps: float) -> float:
     """``track_force_n`` of one track in floats (same bits), N (+ forward)."""
     v_t = track_speed_mps
-    denom = max(abs(v_t), 0.05) * (1.0 if v_t >= 0.0 else -1.0)
-    i = min(max((v_t - ground_speed_mps) / denom, -1.0), 1.0)
+    i = slip_f(v_t, ground_speed_mps)
     w = patch.weight_n
     if i == 0.0 or w <= 0.0:                 # sign(i) x 0 strength: signed zeros as numpy's
         h = 0.0 if i >= 0.0 else -0.0
@@ -245,15 +248,7 @@ def track_force_f(patch: TrackPatch, track_speed_mps: float, ground_speed_mps: f
         if s:
             normal = w + patch.area_m2 * s
     strength = patch.cohesion_n + normal * patch.tan_phi
-    k = patch.shear_modulus_m
-    s_abs = abs(i)
-    if k <= 1e-9:
-        dev = 1.0
-    else:
-        x = s_abs * patch.length_m / k
-        dev = x / 2.0 if x < 1e-6 else 1.0 + float(_expm1(-x)) / x
+    dev = _shear_development_f(abs(i), patch.length_m, patch.shear_modulus_m)
     h = strength * dev if i > 0.0 else -strength * dev
     return h if v_t >= 0.0 else -h
 
-
-_expm1 = np.expm1
