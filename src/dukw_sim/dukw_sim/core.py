@@ -175,6 +175,10 @@ class SimCore:
         # strips over the tracks' contact length: where the surf wets the tracks
         self._track_strips = np.abs(self.hull.station_x_m) <= self._track_len / 2.0
         self._wave_lever_z = params.wave_moments.transverse_force_z_m - self._kg
+        # Morison C_m = 1 + C_a across the hulls too (waves.moments.sway_inertia_from_added_mass)
+        self._sway_inertia_coeff = (1.0 + params.water.sway_added_mass_ratio
+                                    if params.wave_moments.sway_inertia_from_added_mass
+                                    else None)
         self._no_moments = WaveMoments(0.0, 0.0, 0.0)
         self._external = (0.0, 0.0, 0.0)
         self._hydro_key = None
@@ -342,6 +346,9 @@ class SimCore:
         drives = self._track_drives(act, u_rel, w_eff, depths)
         thrust = self._thrust_n(act, water.elevation_m)
         moments = self._wave_moments(areas, water, (c, s))
+        if moments.extra_fy_n or moments.extra_fx_n:   # the strips' sway inertia coefficient
+            waves = waves._replace(fx_n=waves.fx_n + moments.extra_fx_n,
+                                   fy_n=waves.fy_n + moments.extra_fy_n)
         forces = self._body_forces(drives, imm, waves, thrust, w_eff, (u_rel, v_rel, r_rel),
                                    (c, s), moments.yaw_nm)
         tracks = self._integrate_plane(forces, drives, imm.fraction, (c, s))
@@ -440,7 +447,7 @@ class SimCore:
         return wave_moments(self.world.calm, areas, self.hull.strip_length_m, water,
                             self.params.waves, self.vehicle.body.water_density_kgpm3,
                             self.hull.station_x_m, self.hull.station_y_m, yaw_cs,
-                            self._wave_lever_z)
+                            self._wave_lever_z, self._sway_inertia_coeff)
 
     def _water_yaw_rate(self, areas: np.ndarray, water, yaw_cs: tuple) -> float:
         """The water's yaw rate over the hull that the yaw damping acts against (a strip-wise

@@ -142,36 +142,53 @@ def water_yaw_rate_rps(areas_m2: np.ndarray, water: WaterSample, station_x_m: np
 
 class WaveMoments(NamedTuple):
     """Moments about the centre of gravity of the strips' wave forces: yaw (odom z), roll and
-    pitch (body x, y), N m."""
+    pitch (body x, y), N m; and the strips' transverse force beyond the total force of
+    ``wave_forcing`` (which takes the surge inertia coefficient in every direction), odom, N."""
 
     yaw_nm: float
     roll_nm: float
     pitch_nm: float
+    extra_fx_n: float = 0.0
+    extra_fy_n: float = 0.0
 
 
 def wave_moments(calm: bool, areas_m2: np.ndarray, strip_length_m: float, water: WaterSample,
                  waves: WaveParams, rho_kgpm3: float, station_x_m: np.ndarray,
-                 station_y_m: np.ndarray, yaw_cs: tuple, lever_z_m: float) -> WaveMoments:
-    """Each strip's Froude-Krylov + diffraction force C_m rho V a (as ``wave_forcing``)
-    acting at the strip: its horizontal offset from the centre of gravity gives the yaw
-    moment, its height ``lever_z_m`` relative to it (< 0: below) the roll and pitch moments.
-    In a short-crested sea the transverse acceleration differs along the hulls, so the yaw
-    moment does not vanish with the vehicle's symmetry."""
+                 station_y_m: np.ndarray, yaw_cs: tuple, lever_z_m: float,
+                 sway_inertia_coeff: float | None = None) -> WaveMoments:
+    """Each strip's Froude-Krylov + diffraction force acting at the strip: its horizontal
+    offset from the centre of gravity gives the yaw moment, its height ``lever_z_m`` relative
+    to it (< 0: below) the roll and pitch moments. In a short-crested sea the transverse
+    acceleration differs along the hulls, so the yaw moment does not vanish with the vehicle's
+    symmetry.
+
+    Morison's inertia force per strip is C_m rho V a with C_m = 1 + C_a in each direction:
+    along the hulls C_m = ``waves.surge_inertia_coeff`` (1 + the surge added-mass ratio),
+    across them ``sway_inertia_coeff`` (1 + the sway added-mass ratio: the added mass the
+    body's sway inertia carries is the same that the accelerating water exerts; None: the
+    surge one). The transverse force beyond the surge coefficient's is returned (odom) for
+    the total force."""
     if calm:
         return WaveMoments(0.0, 0.0, 0.0)
     c, s = yaw_cs
-    cm_v = waves.surge_inertia_coeff * rho_kgpm3 * areas_m2 * strip_length_m
-    fx = cm_v * water.accel_x_mps2          # odom
-    fy = cm_v * water.accel_y_mps2
+    rho_v = rho_kgpm3 * areas_m2 * strip_length_m
+    cm_x = waves.surge_inertia_coeff
+    cm_y = cm_x if sway_inertia_coeff is None else sway_inertia_coeff
+    ax, ay = water.accel_x_mps2, water.accel_y_mps2
+    along = rho_v * (c * ax + s * ay)           # body axes, per unit C_m
+    across = rho_v * (-s * ax + c * ay)
+    f_along = cm_x * along
+    f_across = cm_y * across
+    fx = c * f_along - s * f_across             # odom
+    fy = s * f_along + c * f_across
     off_x = c * station_x_m - s * station_y_m
     off_y = s * station_x_m + c * station_y_m
     yaw = float(off_x @ fy - off_y @ fx)
-    fx_sum, fy_sum = float(fx.sum()), float(fy.sum())
-    fx_body = c * fx_sum + s * fy_sum
-    fy_body = -s * fx_sum + c * fy_sum
+    fx_body, fy_body = float(f_along.sum()), float(f_across.sum())
+    extra = (cm_y - cm_x) * float(across.sum())
     # REP 103: a force to port below the centre of gravity lifts the port side (+ roll); a
     # force forward below it lifts the bow (- pitch)
-    return WaveMoments(yaw, -lever_z_m * fy_body, lever_z_m * fx_body)
+    return WaveMoments(yaw, -lever_z_m * fy_body, lever_z_m * fx_body, -s * extra, c * extra)
 
 
 def track_wetness(water_over_ground_m: np.ndarray, track_height_m: float) -> float:

@@ -121,7 +121,35 @@ def test_a_uniform_transverse_wave_gives_no_yaw_and_a_gradient_does():
     mass_per_strip = PARAMS.waves.surge_inertia_coeff * 1025.0 * 0.05 * 0.3
     assert twist.yaw_nm == pytest.approx(mass_per_strip * 0.5 * 4.0)
     assert wave_moments(True, AREAS_M2, 0.3, _water(np.zeros(6), 0.5 * STATION_X_M),
-                        *args[1:]) == (0.0, 0.0, 0.0)
+                        *args[1:]) == (0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+def test_the_sway_inertia_coefficient_scales_the_transverse_force_only():
+    """Morison's C_m = 1 + C_a across the hulls: the transverse moments and the force beyond
+    the total's surge C_m grow with it, the surge ones do not; at any heading."""
+    yaw = 0.7
+    cs = (math.cos(yaw), math.sin(yaw))
+    args = (PARAMS.waves, 1025.0, STATION_X_M, STATION_Y_M, cs, -0.11)
+    cm_x = PARAMS.waves.surge_inertia_coeff
+    # water accelerating across the hull (body y) with a gradient along it
+    across = 0.5 * STATION_X_M + 0.2
+    water = _water(-math.sin(yaw) * across, math.cos(yaw) * across)
+    same = wave_moments(False, AREAS_M2, 0.3, water, *args)
+    assert (same.extra_fx_n, same.extra_fy_n) == (0.0, 0.0)
+    assert wave_moments(False, AREAS_M2, 0.3, water, *args, cm_x) == same
+    cm_y = 1.9
+    more = wave_moments(False, AREAS_M2, 0.3, water, *args, cm_y)
+    assert more.yaw_nm == pytest.approx(same.yaw_nm * cm_y / cm_x)
+    assert more.roll_nm == pytest.approx(same.roll_nm * cm_y / cm_x)
+    extra_n = (cm_y - cm_x) * 1025.0 * 0.05 * 0.3 * float(across.sum())
+    assert more.extra_fx_n == pytest.approx(-math.sin(yaw) * extra_n)
+    assert more.extra_fy_n == pytest.approx(math.cos(yaw) * extra_n)
+    # water accelerating along the hull: nothing changes
+    along = _water(math.cos(yaw) * np.full(6, 0.5), math.sin(yaw) * np.full(6, 0.5))
+    base = wave_moments(False, AREAS_M2, 0.3, along, *args)
+    surge = wave_moments(False, AREAS_M2, 0.3, along, *args, cm_y)
+    assert surge.pitch_nm == pytest.approx(base.pitch_nm) and surge.pitch_nm != 0.0
+    assert surge.extra_fy_n == pytest.approx(0.0, abs=1e-9)
 
 
 def test_a_surge_wave_force_below_the_centre_of_gravity_lifts_the_bow():
