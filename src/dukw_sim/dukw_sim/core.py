@@ -187,8 +187,16 @@ class SimCore:
         self._ground_val = None
         self._over_tracks_of = None
         self._over_tracks = None
-        # the strips' squared distance from the centre of gravity (water yaw rate's weights)
-        self._station_r2 = self.hull.station_x_m ** 2 + self.hull.station_y_m ** 2
+        # the water's rotation the yaw damping acts against: each strip's cross-flow weighted
+        # by the sway drag, its along-hull flow by the surge drag (waves.moments.*); the
+        # strips' weighted squared distance from the centre of gravity
+        wat = params.water
+        self._surge_to_sway_drag = (
+            wat.surge_linear_drag_n_per_mps / wat.sway_linear_drag_n_per_mps
+            if params.wave_moments.water_rotation_by_drag
+            and wat.sway_linear_drag_n_per_mps > 0.0 else 1.0)
+        self._station_r2 = (self.hull.station_x_m ** 2
+                            + self._surge_to_sway_drag * self.hull.station_y_m ** 2)
         self._wave_a2 = float(np.sum(self.world.waves.amplitude_m ** 2))
         self.reset()
 
@@ -455,7 +463,7 @@ class SimCore:
         if not self.params.wave_moments.strip_moments or self.world.calm:
             return 0.0
         return water_yaw_rate_rps(areas, water, self.hull.station_x_m, self.hull.station_y_m,
-                                  yaw_cs, self._station_r2)
+                                  yaw_cs, self._station_r2, self._surge_to_sway_drag)
 
     def _water_over_tracks(self) -> np.ndarray:
         """Height of the surface over the sand at the strips along the tracks' contact, m."""

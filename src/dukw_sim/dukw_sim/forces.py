@@ -118,17 +118,21 @@ def wave_forcing(calm: bool, areas_m2: np.ndarray, strip_length_m: float, water:
 
 def water_yaw_rate_rps(areas_m2: np.ndarray, water: WaterSample, station_x_m: np.ndarray,
                        station_y_m: np.ndarray, yaw_cs: tuple,
-                       radius_sq_m2: np.ndarray | None = None) -> float:
-    """The water's own yaw rate over the hull: the least-squares rotation of the wave particle
-    velocity at the immersed strips (body axes, immersed area as weight), rad/s.
+                       radius_sq_m2: np.ndarray | None = None,
+                       surge_to_sway_drag: float = 1.0) -> float:
+    """The water's own yaw rate over the hull: the rotation of the wave particle velocity at
+    the immersed strips that the hull's drag acts against (body axes), rad/s.
 
     The hull drag acts on the velocity relative to the water, strip by strip; in a
     short-crested sea the transverse water velocity differs along the hulls (and the surge
     velocity between them), so the yaw damping acts on r minus this rate, as the surge and sway
-    drag act on u and v minus the water's mean velocity (``wave_forcing``). ``radius_sq_m2``:
-    the strips' x^2 + y^2 if the caller keeps it."""
+    drag act on u and v minus the water's mean velocity (``wave_forcing``). Each strip's
+    relative velocity is weighted by the drag it meets in that direction: the transverse
+    (cross-flow) one by the sway drag, the longitudinal one by ``surge_to_sway_drag`` times
+    it (1: the least-squares rotation, immersed area as weight). ``radius_sq_m2``: the
+    strips' x^2 + surge_to_sway_drag y^2 if the caller keeps it."""
     if radius_sq_m2 is None:
-        radius_sq_m2 = station_x_m ** 2 + station_y_m ** 2
+        radius_sq_m2 = station_x_m ** 2 + surge_to_sway_drag * station_y_m ** 2
     weight = float(areas_m2 @ radius_sq_m2)
     if weight <= 1e-12:
         return 0.0
@@ -137,7 +141,7 @@ def water_yaw_rate_rps(areas_m2: np.ndarray, water: WaterSample, station_x_m: np
     vel_x, vel_y = water.velocity_x_mps[:n], water.velocity_y_mps[:n]
     ub = c * vel_x + s * vel_y
     vb = -s * vel_x + c * vel_y
-    return float(areas_m2 @ (station_x_m * vb - station_y_m * ub)) / weight
+    return float(areas_m2 @ (station_x_m * vb - surge_to_sway_drag * station_y_m * ub)) / weight
 
 
 class WaveMoments(NamedTuple):

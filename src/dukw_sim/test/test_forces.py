@@ -226,3 +226,28 @@ def test_water_yaw_rate_is_the_rotation_of_the_water_over_the_immersed_hull(yaw_
     assert water_yaw_rate_rps(areas, shear, xs, ys, (1.0, 0.0)) > 0.0
     assert water_yaw_rate_rps(bow_dry, shear, xs, ys, (1.0, 0.0)) == 0.0
     assert water_yaw_rate_rps(np.zeros(6), water, xs, ys, (c, s)) == 0.0
+
+
+@pytest.mark.parametrize('yaw_rad', [0.0, 2.5])
+def test_the_water_rotation_weights_each_strips_flow_by_its_drag(yaw_rad):
+    """The hulls' drag acts on the cross-flow (sway drag) more than on the along-hull flow
+    (surge drag): in an irrotational strain (v = S x, u = S y) the cross-flow turns the hull
+    by S, the along-hull flow by -S; weighted equally they give (x^2 - y^2) / (x^2 + y^2) S,
+    by the drags' ratio w (x^2 - w y^2) / (x^2 + w y^2) S. A solid-body rotation stays
+    what it is at any weighting."""
+    xs = np.array([-1.0, 0.0, 1.0, -1.0, 0.0, 1.0])
+    ys = np.array([0.4, 0.4, 0.4, -0.4, -0.4, -0.4])
+    c, s = math.cos(yaw_rad), math.sin(yaw_rad)
+    areas = np.full(6, 0.05)
+    strain = 0.2
+    ub, vb = strain * ys, strain * xs                    # body axes
+    water = _flow(c * ub - s * vb, s * ub + c * vb)
+    x2, y2 = float(np.sum(xs ** 2)), float(np.sum(ys ** 2))
+    for w in (1.0, 0.1, 0.0):
+        expected = strain * (x2 - w * y2) / (x2 + w * y2)
+        assert water_yaw_rate_rps(areas, water, xs, ys, (c, s), surge_to_sway_drag=w) \
+            == pytest.approx(expected, rel=1e-12)
+    ox, oy = c * xs - s * ys, s * xs + c * ys
+    spin = _flow(-0.2 * oy, 0.2 * ox)
+    assert water_yaw_rate_rps(areas, spin, xs, ys, (c, s), surge_to_sway_drag=0.1) \
+        == pytest.approx(0.2, rel=1e-12)
