@@ -150,16 +150,8 @@ def test_surf_transitions_meet_the_papers_force_bands(capsys):
 
 
 def test_without_the_surf_physics_the_surf_rows_fail(capsys):
-    """The check can fail: without the wet-sand resistance the tracks are hardly loaded.
-    Every land-to-sea row falls below its band; sea-to-land the saturated sand's dilatancy
-    alone may bring the hardest push (100 %) to the band's lower edge in some seas (266 N
-    against 260-403 with waves.spreading_exponent_s 6), none of the others."""
+    """The check can fail: without the wet-sand resistance the tracks are hardly loaded."""
     args = ['--only', 'surf_transitions', '--no-zigzags', '--set',
             'surf.wet_motion_resistance_coeff=0']
     assert validate.main(args) == 1
-    lines = capsys.readouterr().out.splitlines()
-    land_to_sea = [line for line in lines if 'land-to-sea' in line]
-    assert len(land_to_sea) == 5 and all(line.endswith('OFF') for line in land_to_sea)
-    ok_rows = [line for line in lines if line.startswith('surf_transitions')
-               and line.endswith('ok')]
-    assert len(ok_rows) <= 1 and all('100 %' in line for line in ok_rows)
+    assert 'score: 0/10 checks ok' in capsys.readouterr().out
