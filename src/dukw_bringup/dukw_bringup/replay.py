@@ -107,10 +107,11 @@ class _Driver:
             self.next_tick_ns += self.period_ns
 
     def feed(self, topic: str, t_ns: int, msg: Any) -> None:
-        out = self.adapter.feed(topic, t_ns * 1e-9, msg)
+        t_s = t_ns * 1e-9
+        out = self.adapter.feed(topic, t_s, msg)
         if out is not None:
             self.latest = out
-            self.rows.append({'t_s': t_ns * 1e-9, **out})
+            self.rows.append({'t_s': t_s, **out})
 
     def compare(self, topic: str, t_ns: int, msg: Any) -> None:
         recorded = self.adapter.recorded(topic, msg)
@@ -187,18 +188,22 @@ def _replay(reader: BagReader, bag: Path, adapters: Sequence[CoreAdapter],
     drivers = [_Driver(a, min(firsts[o] for o in a.outputs if o in firsts)) for a in adapters]
     wanted = outputs.union(*(a.inputs for a in adapters))
     routes: dict[str, tuple[str, Callable[[bytes], Any], list[tuple[_Driver, bool, bool]]]] = {}
+    last_ns = None
     start, start_cpu = time.perf_counter(), time.thread_time()
     for topic, msgtype, t_ns, raw in reader.messages(wanted):
         route = routes.get(topic)
-        if route is None:       # each topic's key, decoder and which driver does what
+        if route is None:       # each topic's key, decoder and the drivers that use it
             key = topic_key(topic)
-            route = routes[topic] = (key, decoder(store, msgtype),
-                                     [(d, key in d.adapter.inputs, key in d.adapter.outputs)
-                                      for d in drivers])
+            route = routes[topic] = (key, decoder(store, msgtype), [
+                (d, key in d.adapter.inputs, key in d.adapter.outputs) for d in drivers
+                if key in d.adapter.inputs or key in d.adapter.outputs])
         key, decode, steps = route
         msg = decode(raw)
         result.messages += 1
+        last_ns = t_ns
         for driver, feeds, compares in steps:
+            # a driver's ticks run when its next message comes (the cores are independent:
+            # the same ticks, in the same order with its own messages, as at every message)
             if driver.next_tick_ns is not None and driver.next_tick_ns < t_ns:
                 driver.run_ticks_until(t_ns, inclusive=False)
             if feeds:
@@ -206,6 +211,9 @@ def _replay(reader: BagReader, bag: Path, adapters: Sequence[CoreAdapter],
             if compares:
                 driver.run_ticks_until(t_ns, inclusive=True)
                 driver.compare(key, t_ns, msg)
+    if last_ns is not None:     # every driver ticks up to the bag's last message
+        for driver in drivers:
+            driver.run_ticks_until(last_ns, inclusive=False)
     result.elapsed_s = time.perf_counter() - start
     result.cpu_s = time.thread_time() - start_cpu
     for driver in drivers:
