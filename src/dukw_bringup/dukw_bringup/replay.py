@@ -190,7 +190,7 @@ def _replay(reader: BagReader, bag: Path, adapters: Sequence[CoreAdapter],
     routes: dict[str, tuple[str, Callable[[bytes], Any], list[tuple[_Driver, bool, bool]]]] = {}
     last_ns = None
     start, start_cpu = time.perf_counter(), time.thread_time()
-    for topic, msgtype, t_ns, raw in reader.messages(wanted):
+    for topic, msgtype, t_ns, raw in reader.message_tuples(wanted):
         route = routes.get(topic)
         if route is None:       # each topic's key, decoder and the drivers that use it
             key = topic_key(topic)

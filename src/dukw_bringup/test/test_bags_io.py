@@ -159,3 +159,49 @@ def test_a_bag_killed_before_its_first_flush_has_no_messages_but_opens(tmp_path)
     shutil.copytree(tmp_path / 'live', tmp_path / 'crashed')
     writer.close()
     assert summarize(tmp_path / 'crashed').message_count == 0
+
+
+GOLDEN = Path(__file__).resolve().parents[3] / 'tests' / 'golden'
+
+
+def _same_as_rosbags(path, topic_sets) -> bool:
+    """message_tuples gives what messages gives; returns whether its own path was taken."""
+    with bag_io.BagReader(path) as bag:
+        for topics in topic_sets:
+            assert list(bag.message_tuples(topics)) == [tuple(m) for m in bag.messages(topics)]
+        return bag_io._plain_mcap(bag.reader) is not None
+
+
+@pytest.mark.parametrize('name', ['land_circle', 'land_to_sea', 'sea_to_land'])
+def test_chunk_reading_gives_rosbags_messages_in_rosbags_order(name):
+    assert _same_as_rosbags(GOLDEN / name, [None, ['imu/data', '/traction'], ['drive_mode']])
+
+
+@pytest.mark.parametrize('compress', [False, True])
+def test_chunk_reading_of_chunks_written_out_of_time_order(tmp_path, compress):
+    # within a chunk: out of order and equal times; chunks that follow each other in time
+    store = bag_io.typestore()
+    with BagWriter(tmp_path / 'bag', compress=compress, flush_period_s=None) as writer:
+        writer.add_topic('/traction', 'dukw_msgs/Traction')
+        writer.add_topic('/other', 'dukw_msgs/Traction')
+        for chunk, times in enumerate(([30, 10, 20, 10], [40, 40, 35, 50], [50, 60])):
+            for k, t_ns in enumerate(times):
+                topic = '/other' if k % 2 else '/traction'
+                writer.write_message(topic, 'dukw_msgs/Traction', t_ns,
+                                     _traction(store, chunk * 10 + k, 0.1 * k))
+            writer.flush()
+    assert _same_as_rosbags(tmp_path / 'bag', [None, ['traction'], ['/other']])
+
+
+def test_overlapping_chunks_are_left_to_rosbags(tmp_path):
+    store = bag_io.typestore()
+    with BagWriter(tmp_path / 'bag', flush_period_s=None) as writer:
+        writer.add_topic('/traction', 'dukw_msgs/Traction')
+        for chunk, times in enumerate(([10, 30], [20, 40])):
+            for k, t_ns in enumerate(times):
+                writer.write_message('/traction', 'dukw_msgs/Traction', t_ns,
+                                     _traction(store, chunk * 10 + k, 0.0))
+            writer.flush()
+    assert not _same_as_rosbags(tmp_path / 'bag', [None])
+    with bag_io.BagReader(tmp_path / 'bag') as bag:
+        assert [m[2] for m in bag.message_tuples()] == [10, 20, 30, 40]
