@@ -120,13 +120,26 @@ Before issue 16's replay work the bag was opened twice (anchor pass + replay) an
 open (metadata.yaml and every topic's QoS YAML, pure-Python ruamel) was timed with the
 messages: 40-80 ms per open, more than a quarter of a 7 s bag's replay. Now: one open,
 timed apart (bag_io.BagReader, ReplayResult.open_s). Then (branch ekfperf) the estimator's
-hot paths: the track-force smoother without filterpy's generic calls (scipy block_diag
-per predict), each hull volume computed once per input and skipped when the hulls are
-clearly dry, scalar weights, the 2-D DGPS gate in closed form. What is left: the
-estimator (about 40 % of the CPU: traction's slip and Wong forces in dukw_model, the
-EKF's predict and updates, estimator._admit's checks, buoyancy in the water), rosbags'
-CDR decoding (~18 %) and MCAP reading (~11 %), the controller (~13 %), the comparisons
-(~5 %). bench_replay's 'bound' line gives the estimator-alone limit per bag."""
+hot paths. Then (branch i16replay, 2026-11-25 04:00 UTC) reading and decoding and the
+replay's own work, results bit-identical (rows and deviations of every golden bag through
+all cores and each core alone compared exactly; golden bags regenerate unchanged):
+bag_io.message_tuples reads the MCAP chunks with one struct call per record (reading
+2.0 -> 0.8 us per message); dukw_bringup.cdr_decode decodes with per-type decoders generated
+from the rosbags type store (one struct call per run of fields, nested types inlined,
+numpy arrays as rosbags makes them: 4.9 -> 3.4 us per message, Imu 5.6 -> 2.7 us,
+Odometry 7.3 -> 3.8 us; checked bit for bit against rosbags on every golden message);
+outputs equal to the recording bit for bit are compared with one dict-view check; a core
+only visits the messages it uses; adapters dispatch by topic. Reading + decoding of
+land_to_sea 37 -> 23 ms CPU. Interleaved A/B, CPU clock, best of 5 per round, four rounds
+at load average 4-6: 22.8-24.5 k -> 25.0-27.3 k msg/s (land_circle), 20.8-23.4 k ->
+23.5-25.8 k (land_to_sea), 20.9-23.1 k -> 23.3-24.7 k (sea_to_land).
+What limits it, measured: the estimator alone (the 'bound' line) is ~110 ms CPU of
+land_to_sea's ~210 ms (at most 47-52 k msg/s with nothing else), so 50 k through all
+cores is out of reach without a cheaper estimator; of the other ~100 ms: the estimator's
+message conversions and rows (~20 ms, ros_convert), the drive controller core (~16 ms,
+~18 us per step spread over ~40 small calls) and its message conversions (~5 ms),
+decoding (~18 ms), the mode manager (~6 ms), comparisons (~8 ms), reading (~4 ms) and the
+replay loop."""
 
 ESTIMATOR_PROFILE_HEADER = """cProfile of the estimator alone (EkfRunner, odometry and
 traction read per estimate, as the replay does) on tests/golden/land_to_sea's inputs,
