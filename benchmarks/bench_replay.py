@@ -129,15 +129,17 @@ from the rosbags type store (one struct call per run of fields, nested types inl
 numpy arrays as rosbags makes them: 4.9 -> 3.4 us per message, Imu 5.6 -> 2.7 us,
 Odometry 7.3 -> 3.8 us; checked bit for bit against rosbags on every golden message);
 outputs equal to the recording bit for bit are compared with one dict-view check; a core
-only visits the messages it uses; adapters dispatch by topic. Reading + decoding of
-land_to_sea 37 -> 23 ms CPU. Interleaved A/B, CPU clock, best of 5 per round, four rounds
-at load average 4-6: 22.8-24.5 k -> 25.0-27.3 k msg/s (land_circle), 20.8-23.4 k ->
-23.5-25.8 k (land_to_sea), 20.9-23.1 k -> 23.3-24.7 k (sea_to_land).
+only visits the messages it uses; adapters dispatch by topic; the drive controller makes
+its hand PI gains once and SidePair.scaled(1.0) returns the pair (controller 15.6 -> 13.4 ms
+per replay, bit-identical). Reading + decoding of
+land_to_sea 37 -> 23 ms CPU. Interleaved A/B (04:15 UTC), CPU clock, best of 5 per round,
+four rounds at load average 4-5: 22.8-24.6 k -> 26.4-28.3 k msg/s (land_circle),
+21.0-24.3 k -> 24.8-26.6 k (land_to_sea), 21.1-24.3 k -> 24.7-26.6 k (sea_to_land).
 What limits it, measured: the estimator alone (the 'bound' line) is ~110 ms CPU of
 land_to_sea's ~210 ms (at most 47-52 k msg/s with nothing else), so 50 k through all
 cores is out of reach without a cheaper estimator; of the other ~100 ms: the estimator's
-message conversions and rows (~20 ms, ros_convert), the drive controller core (~16 ms,
-~18 us per step spread over ~40 small calls) and its message conversions (~5 ms),
+message conversions and rows (~20 ms, ros_convert), the drive controller core (~13 ms,
+~15 us per step spread over ~40 small calls) and its message conversions (~5 ms),
 decoding (~18 ms), the mode manager (~6 ms), comparisons (~8 ms), reading (~4 ms) and the
 replay loop."""
 
