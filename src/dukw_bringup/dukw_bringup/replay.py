@@ -156,8 +156,8 @@ class _Driver:
 
 def _first_output_ns(bag: BagReader, topics: set[str]) -> dict[str, int]:
     firsts: dict[str, int] = {}
-    for message in bag.messages(topics):
-        firsts.setdefault(topic_key(message.topic), message.timestamp_ns)
+    for topic, _, t_ns, _ in bag.message_tuples(topics):
+        firsts.setdefault(topic_key(topic), t_ns)
         if len(firsts) == len(topics):
             break
     return firsts
