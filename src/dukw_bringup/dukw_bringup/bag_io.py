@@ -10,10 +10,8 @@ matching against the relative names of the topic contract.
 from __future__ import annotations
 
 import functools
-import itertools
 import os
 import shutil
-import struct
 import sys
 import time
 from dataclasses import dataclass, field
@@ -25,7 +23,6 @@ from rosbags.interfaces import (Connection, Qos, QosDurability, QosHistory, QosL
 from rosbags.rosbag2 import CompressionFormat, CompressionMode, Reader, StoragePlugin, Writer
 from rosbags.rosbag2.errors import ReaderError
 from rosbags.rosbag2.metadata import dump_qos_v8, dump_qos_v9, parse_qos
-from rosbags.rosbag2.storage_mcap import McapReader, decompress
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
@@ -395,81 +392,6 @@ class BagReader:
         for conn, timestamp, raw in self.reader.messages(connections=conns):
             yield BagMessage(conn.topic, conn.msgtype, timestamp,
                              raw if type(raw) is bytes else bytes(raw))
-
-    def message_tuples(self, topics: Iterable[str] | None = None
-                       ) -> Iterator[tuple[str, str, int, bytes]]:
-        """``messages`` as plain (topic, msgtype, timestamp_ns, raw) tuples, the same ones in
-        the same order. A bag of one chunk-indexed MCAP file whose chunks follow each other
-        in time (what BagWriter writes) is read chunk by chunk here: one ``struct`` call per
-        record where rosbags makes a buffer and four reads (a third of a replay's reading).
-        Any other bag goes through rosbags."""
-        storage = _plain_mcap(self.reader)
-        if storage is None:
-            yield from self.messages(topics)
-            return
-        wanted = None if topics is None else {topic_key(t) for t in topics}
-        channels = {c.id: (c.topic, c.msgtype) for c in storage.connections
-                    if wanted is None or topic_key(c.topic) in wanted}
-        chunks = [c for c in storage.chunks if any(c.channel_count.get(i) for i in channels)]
-        for chunk in chunks:
-            yield from _chunk_messages(storage.bio, chunk, channels)
-
-
-#: MCAP record head (opcode, length) and a Message record's (channel, sequence, log time)
-_RECORD = struct.Struct('<BQ')
-_MESSAGE = struct.Struct('<HIQ')
-_MESSAGE_OPCODE = 0x05
-
-
-def _plain_mcap(reader: Reader) -> McapReader | None:
-    """The reader's one MCAP storage if its chunks never overlap in time, else None."""
-    folder = reader.storage            # rosbags' DirectoryReader: the bag's files
-    storages = getattr(folder, 'storages', ())
-    if len(storages) != 1 or getattr(folder.metadata, 'compression_mode', None) == 'message':
-        return None
-    storage = storages[0]
-    if type(storage) is not McapReader or not storage.chunks or storage.bio is None:
-        return None
-    # rosbags merges the chunks by (time, chunk offset): in this order when none overlap
-    for before, after in itertools.pairwise(storage.chunks):
-        if not (before.message_end_time < after.message_start_time or
-                (before.message_end_time == after.message_start_time and
-                 before.chunk_start_offset < after.chunk_start_offset)):
-            return None
-    return storage
-
-
-def _chunk_messages(bio, chunk, channels: dict[int, tuple[str, str]]
-                    ) -> list[tuple[str, str, int, bytes]]:
-    """One chunk's messages of ``channels``, sorted by time as rosbags sorts them
-    (stably; rosbags.rosbag2.storage_mcap.msgsrc, whose decompress and checks are used)."""
-    bio.seek(chunk.chunk_start_offset + 9 + 24)
-    (crc,) = struct.unpack('<I', bio.read(4))
-    bio.seek(chunk.chunk_start_offset + 9 + 40 + len(chunk.compression))
-    compressed = bio.read(chunk.compressed_size)
-    if len(compressed) != chunk.compressed_size:
-        raise ReaderError(f'Truncated chunk at offset {chunk.chunk_start_offset}.')
-    data = decompress(compressed, chunk.compression, chunk.uncompressed_size, crc)
-    start, stop = chunk.message_start_time, chunk.message_end_time + 1
-    record, head, opcode = _RECORD.unpack_from, _MESSAGE.unpack_from, _MESSAGE_OPCODE
-    out = []
-    pos, end = 0, len(data)
-    while pos < end:
-        op, size = record(data, pos)
-        body, pos = pos + 9, pos + 9 + size
-        if pos > end:
-            raise ReaderError(f'Truncated record in the chunk at {chunk.chunk_start_offset}.')
-        if op == opcode:
-            channel, _, log_time = head(data, body)
-            known = channels.get(channel)
-            if known is not None and start <= log_time < stop:
-                out.append((known[0], known[1], log_time, data[body + 22:pos]))
-    out.sort(key=_timestamp)
-    return out
-
-
-def _timestamp(message: tuple[str, str, int, bytes]) -> int:
-    return message[2]
 
 
 def deserialize(message: BagMessage, store: Typestore | None = None) -> Any:

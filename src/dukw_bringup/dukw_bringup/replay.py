@@ -9,8 +9,8 @@ timer grid is anchored on the first recorded output of that node (so the phase m
 the recording) and advanced in bag time: a tick at time t sees every input stamped at
 or before t. At each recorded output message the adapter's latest replayed output is
 compared with it, quantity by quantity; ``ReplayResult.deviations`` says which quantity
-moved and by how much. ROS-free: messages are decoded into rosbags' message classes
-(field names as in the .msg files) by dukw_bringup.cdr_decode.
+moved and by how much. ROS-free: messages are read and decoded with rosbags (field names
+as in the .msg files).
 """
 from __future__ import annotations
 
@@ -25,7 +25,6 @@ from typing import Any, Callable, Iterable, Sequence
 
 from dukw_bringup.bag_io import (BagError, BagReader, deserialize, read_messages, topic_key,
                                  typestore)
-from dukw_bringup.cdr_decode import decoder
 from dukw_bringup.replay_adapters import ADAPTERS, CoreAdapter
 
 
@@ -156,8 +155,8 @@ class _Driver:
 
 def _first_output_ns(bag: BagReader, topics: set[str]) -> dict[str, int]:
     firsts: dict[str, int] = {}
-    for topic, _, t_ns, _ in bag.message_tuples(topics):
-        firsts.setdefault(topic_key(topic), t_ns)
+    for message in bag.messages(topics):
+        firsts.setdefault(topic_key(message.topic), message.timestamp_ns)
         if len(firsts) == len(topics):
             break
     return firsts
@@ -187,18 +186,19 @@ def _replay(reader: BagReader, bag: Path, adapters: Sequence[CoreAdapter],
                            f'{adapter.name} replay on')
     drivers = [_Driver(a, min(firsts[o] for o in a.outputs if o in firsts)) for a in adapters]
     wanted = outputs.union(*(a.inputs for a in adapters))
-    routes: dict[str, tuple[str, Callable[[bytes], Any], list[tuple[_Driver, bool, bool]]]] = {}
+    routes: dict[str, tuple[str, list[tuple[_Driver, bool, bool]]]] = {}
+    decode = store.deserialize_cdr       # (bag_io.deserialize without its per-call lookup)
     last_ns = None
     start, start_cpu = time.perf_counter(), time.thread_time()
-    for topic, msgtype, t_ns, raw in reader.message_tuples(wanted):
+    for topic, msgtype, t_ns, raw in reader.messages(wanted):
         route = routes.get(topic)
-        if route is None:       # each topic's key, decoder and the drivers that use it
+        if route is None:       # each topic's key and the drivers that use it
             key = topic_key(topic)
-            route = routes[topic] = (key, decoder(store, msgtype), [
+            route = routes[topic] = (key, [
                 (d, key in d.adapter.inputs, key in d.adapter.outputs) for d in drivers
                 if key in d.adapter.inputs or key in d.adapter.outputs])
-        key, decode, steps = route
-        msg = decode(raw)
+        key, steps = route
+        msg = decode(raw, msgtype)
         result.messages += 1
         last_ns = t_ns
         for driver, feeds, compares in steps:
