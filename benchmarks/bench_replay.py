@@ -120,28 +120,24 @@ Before issue 16's replay work the bag was opened twice (anchor pass + replay) an
 open (metadata.yaml and every topic's QoS YAML, pure-Python ruamel) was timed with the
 messages: 40-80 ms per open, more than a quarter of a 7 s bag's replay. Now: one open,
 timed apart (bag_io.BagReader, ReplayResult.open_s). Then (branch ekfperf) the estimator's
-hot paths. Then (branch i16replay, 2026-11-25 04:00 UTC) reading and decoding and the
-replay's own work, results bit-identical (rows and deviations of every golden bag through
-all cores and each core alone compared exactly; golden bags regenerate unchanged):
-bag_io.message_tuples reads the MCAP chunks with one struct call per record (reading
-2.0 -> 0.8 us per message); dukw_bringup.cdr_decode decodes with per-type decoders generated
-from the rosbags type store (one struct call per run of fields, nested types inlined,
-numpy arrays as rosbags makes them: 4.9 -> 3.4 us per message, Imu 5.6 -> 2.7 us,
-Odometry 7.3 -> 3.8 us; checked bit for bit against rosbags on every golden message);
-outputs equal to the recording bit for bit are compared with one dict-view check; a core
-only visits the messages it uses; adapters dispatch by topic; the drive controller makes
-its hand PI gains once and SidePair.scaled(1.0) returns the pair (controller 15.6 -> 13.4 ms
-per replay, bit-identical). Reading + decoding of
-land_to_sea 37 -> 23 ms CPU. Interleaved A/B (04:15 UTC), CPU clock, best of 5 per round,
-four rounds at load average 4-5: 22.8-24.6 k -> 26.4-28.3 k msg/s (land_circle),
-21.0-24.3 k -> 24.8-26.6 k (land_to_sea), 21.1-24.3 k -> 24.7-26.6 k (sea_to_land).
-What limits it, measured: the estimator alone (the 'bound' line) is ~110 ms CPU of
-land_to_sea's ~210 ms (at most 47-52 k msg/s with nothing else), so 50 k through all
-cores is out of reach without a cheaper estimator; of the other ~100 ms: the estimator's
-message conversions and rows (~20 ms, ros_convert), the drive controller core (~13 ms,
-~15 us per step spread over ~40 small calls) and its message conversions (~5 ms),
-decoding (~18 ms), the mode manager (~6 ms), comparisons (~8 ms), reading (~4 ms) and the
-replay loop."""
+hot paths. Then (branch i16replay, 2026-11-25) the replay's own work, results
+bit-identical (golden bags regenerate unchanged): outputs equal to the recording bit for
+bit are compared with one dict-view check; a core only visits the messages it uses;
+adapters dispatch by topic; the drive controller makes its hand PI gains once and
+SidePair.scaled(1.0) returns the pair. Reading and decoding are rosbags' (BagReader.messages
+over rosbags' Reader with the connections filtered once; Typestore.deserialize_cdr, its
+bound method taken once): a hand-written MCAP chunk reader and CDR decoder generator were
+faster (reading + decoding 37 -> 23 ms of land_to_sea) but were dropped for the project's
+library rule. Interleaved A/B against bdc8249 (04:28-04:33 UTC, CPU clock, best of 5 per
+run, eight rounds, load average 4-6): 19.9-24.2 k (median 22.8) -> 21.3-25.3 k (22.5)
+msg/s land_circle, 20.0-22.1 (21.4) -> 17.7-23.1 (21.7) land_to_sea, 20.4-23.2 (21.6) ->
+18.3-23.6 (21.2) sea_to_land: no difference the noise lets through. What limits it,
+measured: the estimator alone (the 'bound' line) is ~110 ms CPU of land_to_sea's ~240 ms
+(at most ~49 k msg/s with nothing else), so 50 k through all cores is out of reach
+without a cheaper estimator; of the rest: rosbags' CDR decoding (~24 ms, ~20 % here) and
+MCAP reading (~11 ms, ~11 % here), the estimator's message conversions and rows, the
+drive controller core (~13 ms) and its conversions, the mode manager, the comparisons
+and the replay loop."""
 
 ESTIMATOR_PROFILE_HEADER = """cProfile of the estimator alone (EkfRunner, odometry and
 traction read per estimate, as the replay does) on tests/golden/land_to_sea's inputs,
