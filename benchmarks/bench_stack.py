@@ -21,8 +21,9 @@ command's publish and delivery. Samples no command followed within 100 ms count 
 message and ended at its receipt of the first command after the estimate: that left out
 the sample's delivery, about 0.2-0.7 ms.)
 
-The stack file's ``realtime_priority`` applies (the chain and the simulator under
-SCHED_FIFO, and then this process too, standing in for the servo switch's driver);
+The stack file's ``realtime_priority`` applies (the control chain under SCHED_FIFO, and
+then this process too, standing in for the servo switch's driver; the simulator 10 below
+the chain, as the boat's IMU and servo switch drivers: ``with_priorities``);
 ``--normal-priority`` runs everything at normal priority, to see what the priority buys.
 
 With ``--cores 1`` the stack's node processes (all but the simulator) are pinned to one
@@ -64,6 +65,8 @@ DEFAULT_STACKS = ('sim_composed', 'sim')
 #: the tracer every process of the stack runs (sitecustomize on PYTHONPATH), and its switch
 TRACER_DIR = Path(__file__).resolve().parent / 'latency_trace'
 TRACE_ENV = 'DUKW_LATENCY_TRACE'
+#: the simulator's SCHED_FIFO priority this far below the chain's: the chain preempts it
+SIM_PRIORITY_BELOW = 10
 
 class Probe:
     """The actuator side: takes tracks/cmd and notes (monotonic ns, stamp ns) of each."""
@@ -105,9 +108,27 @@ class Probe:
             os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
 
 
+def with_priorities(stack, normal: bool):
+    """The stack as measured: every process at normal priority (``normal``), or as its file
+    says plus the simulator under SCHED_FIFO just below the chain (SIM_PRIORITY_BELOW): it
+    stands in for the boat's IMU and servo switch drivers, which run under SCHED_FIFO; at
+    real-time factor 1 it is no hog (the stack files leave it out: at factor 0 it would be)."""
+    chain = max(n.realtime_priority for n in stack.nodes)
+
+    def priority(node) -> int:
+        if normal:
+            return 0
+        if node.name == SIM_NODE and chain and not node.realtime_priority:
+            return max(1, chain - SIM_PRIORITY_BELOW)
+        return node.realtime_priority
+    return replace(stack, nodes=tuple(replace(n, realtime_priority=priority(n))
+                                      for n in stack.nodes))
+
+
 def actuator_priority(stack) -> int:
-    """The real-time priority of the simulator (the actuator side this process stands in for)."""
-    return next((n.realtime_priority for n in stack.nodes if n.name == SIM_NODE), 0)
+    """The control chain's real-time priority (the highest in the stack): this process stands
+    in for the servo switch's driver, which has it on the boat (config/stack_boat*.yaml)."""
+    return max(n.realtime_priority for n in stack.nodes)
 
 
 def load_traces(trace_dir: Path, pids: dict[str, int]) -> dict[str, list]:
@@ -205,8 +226,7 @@ def measure(stack_name: str, args: argparse.Namespace) -> int:
     trace_dir = run_dir / 'trace'
     trace_dir.mkdir()
     stack = load_stack(stack_path(stack_name))
-    if args.normal_priority:
-        stack = replace(stack, nodes=tuple(replace(n, realtime_priority=0) for n in stack.nodes))
+    stack = with_priorities(stack, args.normal_priority)
     config, overlay = prepare_run(run_dir, default_config_path(), stack, load_mission(), 1.0)
     env = {TRACE_ENV: str(trace_dir), 'PYTHONPATH': os.pathsep.join(
         [str(TRACER_DIR)] + [p for p in [os.environ.get('PYTHONPATH')] if p])}

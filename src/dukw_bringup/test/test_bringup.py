@@ -112,16 +112,17 @@ def test_bad_stack_file_is_refused(doc, message):
         parse_stack(doc)
 
 
-def test_the_chain_and_the_devices_at_its_ends_run_under_sched_fifo_in_every_stack():
+def test_the_chain_and_the_boat_devices_at_its_ends_run_under_sched_fifo():
     for name in ('sim', 'sim_composed', 'boat', 'boat_composed'):
         stack = load_stack(stack_path(name))
         fifo = {n.name for n in stack.nodes if n.realtime_priority}
         chain = ({'control_chain'} if 'composed' in name
                  else {'ekf_node', 'mode_manager_node', 'drive_controller_node'})
-        devices = {'sim_node'} if name.startswith('sim') else {'imu_gps_node',
-                                                              'servo_switch_node'}
-        assert chain | devices <= fifo
-        assert not fifo & {'mission_node', 'live_view_node', 'robot_state_node'}
+        devices = set() if name.startswith('sim') else {'imu_gps_node', 'servo_switch_node'}
+        assert fifo == chain | devices
+        priority = {n.name: n.realtime_priority for n in stack.nodes}
+        assert all(priority[d] < priority[c] for d in devices for c in chain)
+        # not the simulator: at real_time_factor 0 it steps flat out, a real-time hog
 
 
 def test_a_process_gets_its_realtime_priority_or_the_runner_says_why_not():
