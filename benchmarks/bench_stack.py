@@ -113,11 +113,11 @@ def with_priorities(stack, normal: bool):
     says plus the simulator under SCHED_FIFO just below the chain (SIM_PRIORITY_BELOW): it
     stands in for the boat's IMU and servo switch drivers, which run under SCHED_FIFO; at
     real-time factor 1 it is no hog (the stack files leave it out: at factor 0 it would be)."""
+    if normal:
+        return stack.at_normal_priority()
     chain = max(n.realtime_priority for n in stack.nodes)
 
     def priority(node) -> int:
-        if normal:
-            return 0
         if node.name == SIM_NODE and chain and not node.realtime_priority:
             return max(1, chain - SIM_PRIORITY_BELOW)
         return node.realtime_priority

@@ -44,7 +44,7 @@ import subprocess
 import sys
 import threading
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import IO, Any, Mapping, Sequence
 
@@ -97,6 +97,11 @@ class StackSpec:
     def node_names(self) -> list[str]:
         """Every ROS node of the stack (a composed process's nodes one by one)."""
         return [name for spec in self.nodes for name in spec.node_names]
+
+    def at_normal_priority(self) -> StackSpec:
+        """The same stack with no process under SCHED_FIFO (faster than real time the wall
+        clock latency means nothing, and a chain working flat out would hog a core)."""
+        return replace(self, nodes=tuple(replace(n, realtime_priority=0) for n in self.nodes))
 
     def node(self, name: str) -> NodeSpec:
         """The node called ``name``; KeyError if there is none."""

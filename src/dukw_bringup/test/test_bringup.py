@@ -122,6 +122,9 @@ def test_the_chain_and_the_boat_devices_at_its_ends_run_under_sched_fifo():
         assert fifo == chain | devices
         priority = {n.name: n.realtime_priority for n in stack.nodes}
         assert all(priority[d] < priority[c] for d in devices for c in chain)
+        normal = stack.at_normal_priority()     # (main_job faster than real time)
+        assert [n.name for n in normal.nodes] == [n.name for n in stack.nodes]
+        assert not any(n.realtime_priority for n in normal.nodes)
         # not the simulator: at real_time_factor 0 it steps flat out, a real-time hog
 
 
