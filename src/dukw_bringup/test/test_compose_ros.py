@@ -167,7 +167,7 @@ def test_the_command_goes_out_before_the_observers_odometry_in_the_imu_callback(
                                  (order.append(n), p(msg)))
         on_imu = next(sub.callback for node in nodes for sub in node.subscriptions
                       if sub.topic_name == '/imu/data')
-        for k in range(20):
+        for _ in range(20):
             imu = Imu()
             imu.header.stamp = ekf.get_clock().now().to_msg()
             imu.orientation.w = 1.0
@@ -175,7 +175,7 @@ def test_the_command_goes_out_before_the_observers_odometry_in_the_imu_callback(
             on_imu(imu)
             time.sleep(0.01)
         assert order.count('odometry/filtered') >= 10
-        pairs = list(zip(order[::2], order[1::2]))
+        pairs = list(zip(order[::2], order[1::2], strict=True))
         assert set(pairs) == {('tracks/cmd', 'odometry/filtered')}
     finally:
         for node in reversed(nodes):
