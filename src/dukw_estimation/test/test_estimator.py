@@ -129,6 +129,29 @@ def test_a_stopped_track_read_slightly_reversed_slips_as_a_stopped_one():
     assert est.traction().port_slip == 1.0
 
 
+def test_the_slip_of_a_belt_spinning_up_compares_speeds_of_one_time():
+    """Belt and vehicle accelerate together at 0.6 m/s^2 without slipping; the status comes
+    every 0.05 s. Between statuses the filter's ground speed runs 0.03 m/s ahead of the last
+    belt reading: the slip is taken at the status's time (else -0.1 at 0.3 m/s)."""
+    est = make()
+    rng = np.random.default_rng(3)
+    x, u, accel = -20.0, 0.0, 0.6
+    worst = 0.0
+    for k in range(1, 151):
+        t = k * 0.01
+        u += accel * 0.01
+        x += u * 0.01
+        est.add_imu(imu(t, 0.0, 0.0, accel + rng.normal(0, 0.01)))
+        if k % 10 == 0:
+            est.add_gps_fix(fix(t, x, 0.0))
+            est.add_gps_velocity(GpsVelocity(t, u, 0.0))
+        if k % 5 == 0:
+            est.add_tracks(tracks(t, u, u))
+        if k % 5 == 4 and 0.2 < u < 0.6 and t > 0.5:
+            worst = max(worst, abs(est.traction().port_slip))
+    assert 0.0 < worst < 0.04
+
+
 def test_on_dry_land_all_weight_on_tracks_and_force_prediction_matches_the_model():
     est = make()
     Drive(est).run(10.0)
