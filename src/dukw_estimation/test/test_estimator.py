@@ -387,6 +387,22 @@ def test_held_tracks_of_a_vehicle_carried_over_the_sand_tell_the_weight():
     assert runs['still'][0].surface.force_update_t_s == -math.inf
 
 
+def test_an_unlearnt_soil_widens_the_track_force_noise():
+    """force_update.max_soil_spread above the prior's spread never waits, but the soil's
+    spread (the prior's, no dry sand yet) widens each update's noise: the forces move the
+    surface less than with the configured soil trusted, and still some."""
+    fractions = {}
+    for name, changes in (('trusted', {'force_update_max_soil_spread': 0.0}),
+                          ('widened', {'force_update_max_soil_spread': 10.0}),
+                          ('deaf', {'force_update_sigma_n': 0.0})):
+        est = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, **changes)
+        truth = _surf_run(est, -0.06, 0.4, seconds=1.0)
+        fractions[name] = est.traction().weight_on_tracks_fraction
+    assert fractions['deaf'] < fractions['widened'] - 0.01
+    assert fractions['widened'] < fractions['trusted'] - 0.01
+    assert fractions['trusted'] < truth + 0.05
+
+
 def test_track_forces_wait_until_the_sites_soil_is_learnt():
     """With force_update.max_soil_spread set: meeting the sand in the surf (no dry sand
     yet), the soil is only the configured prior, whose error would read as water, so the
