@@ -29,17 +29,17 @@ from dukw_common.vehicle import SoilParams, Vehicle
 from dukw_model import traction
 from dukw_model.propeller import prop_thrust_n, propeller_thrust_factor
 
-from dukw_sim.forces import (LATERAL_POINTS, BodyForces, Immersion, WaveForcing, WaveMoments,
-                             drivetrain_friction_n, hydrodynamic_drag, immersion,
+from dukw_sim.forces import (LATERAL_POINTS, BodyForces, Immersion, StripSums, WaveForcing,
+                             WaveMoments, drivetrain_friction_n, hydrodynamic_drag, immersion,
                              lateral_resistance, odom_force, paddle_wrench, propulsion,
-                             rolling_resistance, saturated_share, slope_gravity, sum_wrenches,
-                             surf_resistance, track_paddle_n, track_wetness, water_yaw_rate_rps,
-                             wave_forcing, wave_moments)
+                             rolling_resistance, saturated_share, slope_gravity, strip_basis,
+                             strip_sums, sum_wrenches, surf_resistance, track_paddle_n,
+                             track_wetness, water_yaw_rate_rps, wave_forcing, wave_moments)
 from dukw_sim.hull import HullGeometry, Seakeeping
 from dukw_sim.land import TrackContact, TrackLinear, linearise, motor_limited_speed
 from dukw_sim.params import SimParams, apply_overrides
 from dukw_sim.truth import Medium, Truth
-from dukw_sim.world import (Beach, WaveModel, World, irregular_waves, no_waves,
+from dukw_sim.world import (Beach, WaterSample, WaveModel, World, irregular_waves, no_waves,
                             regular_waves)
 
 __all__ = ['Actuation', 'SimCore', 'SimParams']
@@ -67,6 +67,16 @@ class _Drives(NamedTuple):
     loop_k: tuple                # speed-loop stiffness, N per m/s (inf: holds its speed)
     contact: TrackContact | None
     lin: TrackLinear             # the soil forces linearised at the step's ground speeds
+
+
+class _Hydro(NamedTuple):
+    """The water at the sample points and the strips' immersion for one pose (cached)."""
+
+    px: np.ndarray               # odom x of the sample points (then of the kinematic rows)
+    water: WaterSample
+    depths: np.ndarray           # water over each strip's bottom, m
+    areas: np.ndarray            # each strip's immersed section, m^2
+    sums: StripSums              # their area-weighted sums
 
 
 class _Stepped(NamedTuple):
@@ -170,6 +180,7 @@ class SimCore:
                                        s.depth_sounder_x_m, prop.x_m, prop.x_m]])
         self._pts_y = np.concatenate([self.hull.station_y_m,
                                       [0.0, 0.0, 0.0, 0.0, self._half_sep, -self._half_sep]])
+        self._pts_rows = self.world.rigid_rows(self._pts_x, self._pts_y, n)
         self._lat_s = [self._track_len * ((j + 0.5) / LATERAL_POINTS - 0.5)
                        for j in range(LATERAL_POINTS)]
         # strips over the tracks' contact length: where the surf wets the tracks
@@ -183,8 +194,8 @@ class SimCore:
         self._ground_val = None
         self._over_tracks_of = None
         self._over_tracks = None
-        # the strips' squared distance from the centre of gravity (water yaw rate's weights)
-        self._station_r2 = self.hull.station_x_m ** 2 + self.hull.station_y_m ** 2
+        # the strips' rows 1, x, y, x^2 + y^2: their area-weighted sums (forces.strip_sums)
+        self._strip_basis = strip_basis(self.hull.station_x_m, self.hull.station_y_m)
         self._wave_a2 = float(np.sum(self.world.waves.amplitude_m ** 2))
         self.reset()
 
@@ -285,29 +296,28 @@ class SimCore:
                   + self.hull.station_y_m * math.sin(roll))
         return eta[:n] - bottom
 
-    def _hydro(self):
+    def _hydro(self) -> _Hydro:
         """Water at the sample points and the strips' immersion for the current pose (cached)."""
         key = (self.t_s, self.x, self.y, self.yaw, self.z_cg, self.pitch, self.roll)
         if self._hydro_key == key:
             return self._hydro_val
-        c, s = math.cos(self.yaw), math.sin(self.yaw)
-        px = self.x + c * self._pts_x - s * self._pts_y
-        py = self.y + s * self._pts_x + c * self._pts_y
-        water = self.world.sample(px, py, self.t_s, self._n_stations,
-                                  self.z_cg + self.hull.axis_above_cg_m)
+        px, water = self.world.sample_rigid(self._pts_rows, self._pts_x.size, self.x, self.y,
+                                            math.cos(self.yaw), math.sin(self.yaw), self.t_s,
+                                            self.z_cg + self.hull.axis_above_cg_m)
         depths = self._strip_depths(water.elevation_m, self.z_cg, self.pitch, self.roll)
         areas = self.hull.areas_m2(depths)
         self._hydro_key = key
-        self._hydro_val = (px, water, depths, areas)
+        self._hydro_val = _Hydro(px, water, depths, areas,
+                                 strip_sums(areas, water, self._strip_basis))
         return self._hydro_val
 
     def _grounded_buoyancy(self) -> float:
-        areas = self._hydro()[3]
-        return self._rho_g * float(areas.sum()) * self.hull.strip_length_m
+        sums = self._hydro().sums
+        return self._rho_g * sums.area_m2 * self.hull.strip_length_m
 
     def _float_height(self) -> float:
         """Centre-of-gravity height at which the level hull floats on the current surface."""
-        water = self._hydro()[1]
+        water = self._hydro().water
         lo, hi = -5.0, 5.0
         for _ in range(60):
             mid = 0.5 * (lo + hi)
@@ -329,26 +339,26 @@ class SimCore:
         u0, v0, hv0 = self.u, self.v, self.heave_vel
         c, s = math.cos(self.yaw), math.sin(self.yaw)
         imm, w_eff = self._contact_and_immersion()
-        _, water, depths, areas = self._hydro()
+        _, water, depths, areas, sums = self._hydro()
         body = self.vehicle.body
         waves = wave_forcing(self.world.calm, areas, self.hull.strip_length_m, water,
                              self.params.waves, body.water_density_kgpm3, self._rho_g,
-                             self._wave_a2, body.beam_m, imm)
+                             self._wave_a2, body.beam_m, imm, sums)
         # water velocity in body axes
         uw = c * waves.water_u_mps + s * waves.water_v_mps
         vw = -s * waves.water_u_mps + c * waves.water_v_mps
         u_rel, v_rel = u0 - uw, v0 - vw
-        r_rel = self.r - self._water_yaw_rate(areas, water, (c, s))
+        r_rel = self.r - self._water_yaw_rate(areas, water, (c, s), sums)
         drives = self._track_drives(act, u_rel, w_eff, depths)
         thrust = self._thrust_n(act, water.elevation_m)
-        moments = self._wave_moments(areas, water, (c, s))
+        moments = self._wave_moments(areas, water, (c, s), sums)
         forces = self._body_forces(drives, imm, waves, thrust, w_eff, (u_rel, v_rel, r_rel),
                                    (c, s), moments.yaw_nm)
         tracks = self._integrate_plane(forces, drives, imm.fraction, (c, s))
         if self.in_contact:
             self._follow_ground()
         else:
-            self._float_free(imm, moments)
+            self._float_free(imm, moments, sums)
         self.t_s += dt
         accel = ((self.u - u0) / dt - self.r * self.v, (self.v - v0) / dt + self.r * self.u,
                  (self.heave_vel - hv0) / dt)
@@ -362,8 +372,9 @@ class SimCore:
         gz, gpitch, groll, slope = self._ground_pose()
         if self.in_contact:
             self.z_cg, self.pitch, self.roll = gz + self._kg, gpitch, groll
-        areas = self._hydro()[3]
-        imm = immersion(areas, self.hull.strip_length_m, self._rho_g, self._afloat_volume)
+        areas, sums = self._hydro()[3:]
+        imm = immersion(areas, self.hull.strip_length_m, self._rho_g, self._afloat_volume,
+                        sums.area_m2)
         if self.in_contact and imm.buoyancy_n >= self._weight:
             self.in_contact = False
         if not (self.in_contact or self.grazing):
@@ -433,22 +444,24 @@ class SimCore:
         return [prop_thrust_n(act.port_prop_pct, drive) * prop_share[0],
                 prop_thrust_n(act.stbd_prop_pct, drive) * prop_share[1]]
 
-    def _wave_moments(self, areas: np.ndarray, water, yaw_cs: tuple) -> WaveMoments:
+    def _wave_moments(self, areas: np.ndarray, water, yaw_cs: tuple,
+                      sums: StripSums) -> WaveMoments:
         """The strips' wave moments (waves.moments.strip_moments), else none."""
         if not self.params.wave_moments.strip_moments or self.world.calm:
             return self._no_moments
         return wave_moments(self.world.calm, areas, self.hull.strip_length_m, water,
                             self.params.waves, self.vehicle.body.water_density_kgpm3,
                             self.hull.station_x_m, self.hull.station_y_m, yaw_cs,
-                            self._wave_lever_z)
+                            self._wave_lever_z, sums)
 
-    def _water_yaw_rate(self, areas: np.ndarray, water, yaw_cs: tuple) -> float:
+    def _water_yaw_rate(self, areas: np.ndarray, water, yaw_cs: tuple,
+                        sums: StripSums) -> float:
         """The water's yaw rate over the hull that the yaw damping acts against (a strip-wise
         wave moment too: waves.moments.strip_moments), else 0, rad/s."""
         if not self.params.wave_moments.strip_moments or self.world.calm:
             return 0.0
         return water_yaw_rate_rps(areas, water, self.hull.station_x_m, self.hull.station_y_m,
-                                  yaw_cs, self._station_r2)
+                                  yaw_cs, sums)
 
     def _water_over_tracks(self) -> np.ndarray:
         """Height of the surface over the sand at the strips along the tracks' contact, m."""
@@ -559,14 +572,14 @@ class SimCore:
         self.pitch_rate = (npitch - self.pitch) / dt
         self.z_cg, self.pitch, self.roll = nz, npitch, nroll
 
-    def _float_free(self, imm: Immersion, waves: WaveMoments) -> None:
+    def _float_free(self, imm: Immersion, waves: WaveMoments, sums: StripSums) -> None:
         """Afloat: heave, roll and pitch under the strips' buoyancy (and the waves' strip
         moments), with damping scaled by the submerged share, then touch down if a track end
         reaches the sand."""
         dt, sk, frac = self.dt_s, self.seakeeping, imm.fraction
-        strip_f = imm.strip_force_n
-        m_roll = float(strip_f @ self.hull.station_y_m)
-        m_pitch = -float(strip_f @ self.hull.station_x_m)
+        strip_f = self._rho_g * self.hull.strip_length_m    # the strips' buoyancy per m^2
+        m_roll = strip_f * sums.area_y_m3
+        m_pitch = -strip_f * sums.area_x_m3
         if waves is not self._no_moments:
             m_roll += waves.roll_nm
             m_pitch += waves.pitch_nm
@@ -759,9 +772,9 @@ class SimCore:
 
     def _compute_truth(self, act: Actuation, stepped: _Stepped | None) -> Truth:
         c, s = math.cos(self.yaw), math.sin(self.yaw)
-        px, water, depths, areas = self._hydro()
+        px, water, _, _, sums = self._hydro()
         eta = water.elevation_m[self._n_stations:].tolist()   # base_link, fore, aft, sounder
-        volume = float(areas.sum()) * self.hull.strip_length_m
+        volume = sums.area_m2 * self.hull.strip_length_m
         beach = self.world.beach
         ground = beach.height_m(self.x)
         sp, cp = math.sin(self.pitch), math.cos(self.pitch)

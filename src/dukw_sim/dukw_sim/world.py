@@ -281,6 +281,13 @@ class World:
         self._wavenumbers[0], self._wavenumbers[1] = waves.kx, waves.ky
         self._wavenumbers[3] = -0.5 * math.pi
         self._time_key: float | None = None
+        # sample_rigid: [kx; ky; phase; omega], its (3, 4) coefficients and the phase matrix
+        self._rigid_waves = np.vstack([waves.kx, waves.ky, waves.phase_rad, waves.omega_rps])
+        self._rigid_coef = np.zeros((3, 4))
+        self._rigid_coef[2, 2] = 1.0
+        self._rigid_phase = np.zeros((4, waves.count))
+        self._rigid_phase[3] = -0.5 * math.pi
+        self._rigid_odom = np.zeros(4)
         self._transfer_key: tuple[float, float] | None = None
         self._sinh_depth: float | None = None
         self._sinh_kd = np.zeros(0)
@@ -362,12 +369,60 @@ class World:
         """``sample`` of flat float arrays x, y of n points, 0 <= kin_points <= n, waves
         present and some point seaward of the waterline (the simulator's call every step,
         without the checks)."""
-        n = x.size
         rows = self._point_rows(x, y, kin_points)
         trig = np.cos(rows @ self._phase_matrix(t_s))   # cos on the first n rows, then sin
-        factor = _interp(rows[:, 0], self._cap_x, self._cap)
+        return self._combine(trig, rows[:, 0], x.size, kin_points, kin_height_m)
+
+    def rigid_rows(self, body_x_m: np.ndarray, body_y_m: np.ndarray,
+                   kin_points: int) -> np.ndarray:
+        """The rows ``sample_rigid`` takes for points fixed in a body (body frame x, y):
+        [x, y, 1, 0] of every point, then [x, y, 1, 1] of the first ``kin_points``."""
+        bx = np.asarray(body_x_m, dtype=float).ravel()
+        by = np.asarray(body_y_m, dtype=float).ravel()
+        if bx.shape != by.shape or not 0 <= kin_points <= bx.size:
+            raise ValueError('rigid_rows needs x and y of the same size, 0 <= kin_points <= n')
+        rows = np.zeros((bx.size + kin_points, 4))
+        rows[:bx.size, 0], rows[:bx.size, 1] = bx, by
+        rows[bx.size:, :2] = rows[:kin_points, :2]
+        rows[:, 2] = 1.0
+        rows[bx.size:, 3] = 1.0
+        return rows
+
+    def sample_rigid(self, rows: np.ndarray, n: int, x_m: float, y_m: float, cos_yaw: float,
+                     sin_yaw: float, t_s: float,
+                     kin_height_m: float) -> tuple[np.ndarray, WaterSample]:
+        """``sample`` at n points fixed in a body whose origin is at (x, y) with this heading
+        (``rows`` from ``rigid_rows``; the kinematics at the rows after the n-th), and the
+        points' odom x (one value per row).
+
+        A point's phase k.(X + R b) + phase - omega t is b_x (R^T k)_x + b_y (R^T k)_y plus
+        the body origin's phase: one (3, 4) x (4, M) product per step gives the rotated
+        wavenumbers and the origin's phase, which is kept in [0, 2 pi) so that the cosines'
+        arguments stay small (a few radians over the body, not k x + omega t).
+        """
+        odom = self._rigid_odom
+        odom[0], odom[1], odom[2] = cos_yaw, -sin_yaw, x_m
+        px = rows @ odom
+        kin_points = rows.shape[0] - n
+        if self._calm or px[:n].max() <= 0.0:     # calm, or all on the sand: no wave
+            kin = np.zeros(kin_points)
+            return px, WaterSample(np.zeros(n), kin, kin, kin, kin)
+        coef = self._rigid_coef
+        coef[0, 0] = coef[1, 1] = cos_yaw
+        coef[0, 1], coef[1, 0] = sin_yaw, -sin_yaw
+        coef[2, 0], coef[2, 1], coef[2, 3] = x_m, y_m, -t_s
+        phase = self._rigid_phase
+        np.matmul(coef, self._rigid_waves, out=phase[:3])
+        np.remainder(phase[2], 2.0 * math.pi, out=phase[2])
+        trig = np.cos(rows @ phase)                 # cos on the first n rows, then sin
+        return px, self._combine(trig, px, n, kin_points, kin_height_m)
+
+    def _combine(self, trig: np.ndarray, row_x: np.ndarray, n: int, kin_points: int,
+                 kin_height_m: float) -> WaterSample:
+        """Elevation and kinematics from the rows' cosines (then sines) of the phases."""
+        factor = _interp(row_x, self._cap_x, self._cap)
         if kin_points:
-            self._set_transfer(x[:kin_points], kin_height_m)
+            self._set_transfer(row_x[:kin_points], kin_height_m)
             out = trig @ self._weights
         else:
             out = trig @ self._weights[:, :1]
