@@ -188,6 +188,7 @@ class SimCore:
         self._wave_lever_z = params.wave_moments.transverse_force_z_m - self._kg
         self._no_moments = WaveMoments(0.0, 0.0, 0.0)
         self._external = (0.0, 0.0, 0.0)
+        self._valid_act: Actuation | None = None
         self._hydro_key = None
         self._hydro_val = None
         self._ground_key = None
@@ -196,6 +197,7 @@ class SimCore:
         self._over_tracks = None
         # the strips' rows 1, x, y, x^2 + y^2: their area-weighted sums (forces.strip_sums)
         self._strip_basis = strip_basis(self.hull.station_x_m, self.hull.station_y_m)
+        self._strip_tilt = np.column_stack([-self.hull.station_x_m, self.hull.station_y_m])
         self._wave_a2 = float(np.sum(self.world.waves.amplitude_m ** 2))
         self.reset()
 
@@ -291,10 +293,10 @@ class SimCore:
 
     def _strip_depths(self, eta: np.ndarray, z_cg: float, pitch: float,
                       roll: float) -> np.ndarray:
-        n = self._n_stations
-        bottom = (z_cg + self.hull.bottom_above_cg_m - self.hull.station_x_m * math.sin(pitch)
-                  + self.hull.station_y_m * math.sin(roll))
-        return eta[:n] - bottom
+        # eta - (z_cg + bottom - x sin(pitch) + y sin(roll)): one product for the tilt
+        depths = eta[:self._n_stations] - self._strip_tilt @ (math.sin(pitch), math.sin(roll))
+        depths -= z_cg + self.hull.bottom_above_cg_m
+        return depths
 
     def _hydro(self) -> _Hydro:
         """Water at the sample points and the strips' immersion for the current pose (cached)."""
@@ -332,9 +334,10 @@ class SimCore:
     # ----------------------------------------------------------------------- step
     def step(self, act: Actuation) -> Truth:
         """Advance one step of dt_s with the commands ``act``; return the new Truth."""
-        if not isinstance(act, Actuation):
-            raise ValueError(f'step needs an Actuation, got {type(act).__name__}')
-        act.validated()
+        if act is not self._valid_act:         # frozen: a command checked once stays valid
+            if not isinstance(act, Actuation):
+                raise ValueError(f'step needs an Actuation, got {type(act).__name__}')
+            self._valid_act = act.validated()
         dt = self.dt_s
         u0, v0, hv0 = self.u, self.v, self.heave_vel
         c, s = math.cos(self.yaw), math.sin(self.yaw)
@@ -751,24 +754,23 @@ class SimCore:
             return Medium.LAND
         return Medium.TRANSITION
 
-    def _sensor_depths(self, px: np.ndarray, eta: list) -> tuple[float, float, float]:
+    def _sensor_depths(self, px: np.ndarray, eta: list, sp: float,
+                       cp_cr: float) -> tuple[float, float, float]:
         """Fore and aft water sensors' depth under the surface, and the sounder's reading:
-        the depth of the water under it, or (out of the water) minus its height above it."""
+        the depth of the water under it, or (out of the water) minus its height above it.
+        ``sp``: sin(pitch), ``cp_cr``: cos(pitch) cos(roll); a sensor at body (x, z) is at
+        base_z - x sp + z cp_cr."""
         sens = self.vehicle.sensors
         base_z = self.z_cg - self._kg
-        sp, cp, cr = math.sin(self.pitch), math.cos(self.pitch), math.cos(self.roll)
-
-        def sensor_z(bx: float, bz: float) -> float:
-            return base_z - bx * sp + bz * cp * cr
-
-        sounder_z = sensor_z(sens.depth_sounder_x_m, sens.depth_sounder_z_m)
+        sounder_z = base_z - sens.depth_sounder_x_m * sp + sens.depth_sounder_z_m * cp_cr
         sounder_ground = self.world.beach.height_m(float(px[self._n_stations + 3]))
         if eta[3] > sounder_z:
             sounder = sounder_z - sounder_ground
         else:
             sounder = eta[3] - sounder_z
-        return (eta[1] - sensor_z(sens.fore_water_x_m, sens.fore_water_z_m),
-                eta[2] - sensor_z(sens.aft_water_x_m, sens.aft_water_z_m), sounder)
+        return (eta[1] - (base_z - sens.fore_water_x_m * sp + sens.fore_water_z_m * cp_cr),
+                eta[2] - (base_z - sens.aft_water_x_m * sp + sens.aft_water_z_m * cp_cr),
+                sounder)
 
     def _compute_truth(self, act: Actuation, stepped: _Stepped | None) -> Truth:
         c, s = math.cos(self.yaw), math.sin(self.yaw)
@@ -779,7 +781,7 @@ class SimCore:
         ground = beach.height_m(self.x)
         sp, cp = math.sin(self.pitch), math.cos(self.pitch)
         sr, cr = math.sin(self.roll), math.cos(self.roll)
-        fore, aft, sounder = self._sensor_depths(px, eta)
+        fore, aft, sounder = self._sensor_depths(px, eta, sp, cp * cr)
         st = self._at_rest(volume) if stepped is None else stepped
         accel, tracks, thrust, w_eff = st.accel, st.tracks, st.thrust_n, st.w_eff_n
         g_up = self._g + accel[2]

@@ -290,7 +290,7 @@ class World:
         self._rigid_odom = np.zeros(4)
         self._transfer_key: tuple[float, float] | None = None
         self._sinh_depth: float | None = None
-        self._sinh_kd = np.zeros(0)
+        self._kin_per_sinh = np.zeros((0, 4))
         self._points = np.zeros((0, 4))
         self._points_key = (0, 0)
         self._still_x = np.array([beach.flat_start_x_m, beach.sea_floor_x_m])
@@ -441,11 +441,10 @@ class World:
         if (zc, depth) == self._transfer_key:     # e.g. the hull above the water
             return
         if depth != self._sinh_depth:             # e.g. off the slope: the sea floor's depth
-            self._sinh_kd = np.sinh(self._k * depth)
+            self._kin_per_sinh = self._kin_weights / np.sinh(self._k * depth)[:, None]
             self._sinh_depth = depth
         transfer = np.cosh(self._k * (zc + depth))
-        transfer /= self._sinh_kd
-        np.multiply(transfer[:, None], self._kin_weights, out=self._weights[:, 1:])
+        np.multiply(transfer[:, None], self._kin_per_sinh, out=self._weights[:, 1:])
         self._transfer_key = (zc, depth)
 
     def elevation_m(self, x_m: float, y_m: float, t_s: float) -> float:
