@@ -361,6 +361,7 @@ class SensorModel:
                        'gps_vel': NoiseStream(rngs[2], 3), 'water': NoiseStream(rngs[3], 2),
                        'depth': NoiseStream(rngs[4], 1), 'tracks': NoiseStream(rngs[5], 6),
                        'props': NoiseStream(rngs[6], 6)}
+        self._imu_noise = self._noise['imu']
         first = rngs[7].standard_normal(9).tolist()
         self._gyro_bias = tuple(noise.gyro_bias_std_rps * d for d in first[:3])
         att, head, tau = noise.attitude_std_rad, noise.heading_std_rad, noise.attitude_tau_s
@@ -413,8 +414,9 @@ class SensorModel:
         """The IMU at imu_link: its EKF's attitude, gyro rates with bias, specific force."""
         noise, h = self.config.noise, self.config.mounts.imu_z_m
         dt = self._dt('imu', truth.t_s)
-        d = self._noise['imu'].draw()
-        err = [e.step(dt, d[6 + k]) for k, e in enumerate(self._attitude_error)]
+        d = self._imu_noise.draw()
+        roll_err, pitch_err, head_err = self._attitude_error
+        err = (roll_err.step(dt, d[6]), pitch_err.step(dt, d[7]), head_err.step(dt, d[8]))
         wx, wy, wz = truth.roll_rate_rps, truth.pitch_rate_rps, truth.yaw_rate_rps
         last = self._last_rates
         if last is not None and dt > 0:
