@@ -189,6 +189,8 @@ class SimCore:
         self._no_moments = WaveMoments(0.0, 0.0, 0.0)
         self._external = (0.0, 0.0, 0.0)
         self._valid_act: Actuation | None = None
+        self._open_water_of: Actuation | None = None     # the propellers' open-water thrust
+        self._open_water = (0.0, 0.0)
         self._hydro_key = None
         self._hydro_val = None
         self._ground_key = None
@@ -443,9 +445,13 @@ class SimCore:
     def _thrust_n(self, act: Actuation, eta: np.ndarray) -> list[float]:
         """Port and starboard propeller thrust, N, with their depth under the surface."""
         drive = self.vehicle.drivetrain
+        if act is not self._open_water_of:      # per command (frozen)
+            self._open_water = (prop_thrust_n(act.port_prop_pct, drive),
+                                prop_thrust_n(act.stbd_prop_pct, drive))
+            self._open_water_of = act
+        port, stbd = self._open_water
         prop_share = self._prop_thrust_factors(eta)
-        return [prop_thrust_n(act.port_prop_pct, drive) * prop_share[0],
-                prop_thrust_n(act.stbd_prop_pct, drive) * prop_share[1]]
+        return [port * prop_share[0], stbd * prop_share[1]]
 
     def _wave_moments(self, areas: np.ndarray, water, yaw_cs: tuple,
                       sums: StripSums) -> WaveMoments:
@@ -689,11 +695,12 @@ class SimCore:
         """Port and starboard thrust shares from each propeller's depth under the surface."""
         prop = self.params.propeller
         hub_z = (self.z_cg + prop.hub_z_m - self._kg - prop.x_m * math.sin(self.pitch))
-        n = self._n_stations
-        return [propeller_thrust_factor(
-                    float(eta[n + 4 + i]) - (hub_z + y * math.sin(self.roll)),
-                    prop.diameter_m, prop.ventilation_depth_m)
-                for i, y in enumerate((self._half_sep, -self._half_sep))]
+        n, sr = self._n_stations, math.sin(self.roll)
+        port_eta, stbd_eta = eta[n + 4:n + 6].tolist()
+        return [propeller_thrust_factor(port_eta - (hub_z + self._half_sep * sr),
+                                        prop.diameter_m, prop.ventilation_depth_m),
+                propeller_thrust_factor(stbd_eta - (hub_z + -self._half_sep * sr),
+                                        prop.diameter_m, prop.ventilation_depth_m)]
 
     def _touchdown(self) -> None:
         """Land on the sand when a track end reaches it (an inelastic contact).
