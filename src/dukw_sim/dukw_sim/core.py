@@ -795,31 +795,25 @@ class SimCore:
         currents, prop_i, battery = self._electrical(tracks, thrust)
         # touching now, or during the step just taken (its track forces acted on the sand)
         touching = self.in_contact or self.grazing or w_eff > 0.0
+        # positional, in Truth's field order (47 keyword arguments cost ~1.5 us a step more)
         return Truth(
-            t_s=self.t_s, x_m=self.x, y_m=self.y, z_m=self.z_cg - self._kg,
-            roll_rad=self.roll, pitch_rad=self.pitch, yaw_rad=self.yaw,
-            surge_mps=self.u, sway_mps=self.v, heave_mps=self.heave_vel,
-            roll_rate_rps=self.roll_rate, pitch_rate_rps=self.pitch_rate,
-            yaw_rate_rps=self.r,
-            accel_x_mps2=accel[0] - g_up * sp,
-            accel_y_mps2=accel[1] + g_up * sr * cp,
-            accel_z_mps2=g_up * cr * cp,
-            port_cmd_pct=act.port_track_pct, stbd_cmd_pct=act.stbd_track_pct,
-            port_track_speed_mps=tracks.track_speed_mps[0],
-            stbd_track_speed_mps=tracks.track_speed_mps[1],
-            port_slip=tracks.slip[0], stbd_slip=tracks.slip[1],
-            port_force_n=tracks.soil_force_n[0], stbd_force_n=tracks.soil_force_n[1],
-            port_current_a=currents[0], stbd_current_a=currents[1],
-            port_prop_cmd_pct=act.port_prop_pct, stbd_prop_cmd_pct=act.stbd_prop_pct,
-            port_thrust_n=thrust[0], stbd_thrust_n=thrust[1],
-            port_prop_current_a=prop_i[0], stbd_prop_current_a=prop_i[1],
-            battery_voltage_v=battery,
-            submerged_volume_m3=volume, effective_weight_n=w_eff,
-            weight_on_tracks_fraction=(max(self._weight - self._rho_g * volume, 0.0)
-                                       / self._weight if touching else 0.0),
-            waterline_distance_m=beach.distance_along_slope_m(self.x),
-            slope_rad=math.atan(abs(beach.gradient(self.x))), ground_height_m=ground,
-            wave_elevation_m=eta[0], water_depth_m=eta[0] - ground,
-            fore_sensor_depth_m=fore, aft_sensor_depth_m=aft,
-            sounder_depth_m=sounder, medium=self._medium(touching, volume),
-            wave_surge_force_n=c * st.wave_fx_n + s * st.wave_fy_n, in_ground_contact=touching)
+            self.t_s, self.x, self.y, self.z_cg - self._kg,                  # t, x, y, z
+            self.roll, self.pitch, self.yaw,
+            self.u, self.v, self.heave_vel,                                  # surge, sway, heave
+            self.roll_rate, self.pitch_rate, self.r,
+            accel[0] - g_up * sp, accel[1] + g_up * sr * cp, g_up * cr * cp,   # accel x, y, z
+            act.port_track_pct, act.stbd_track_pct,                          # port/stbd cmd
+            tracks.track_speed_mps[0], tracks.track_speed_mps[1],
+            tracks.slip[0], tracks.slip[1],
+            tracks.soil_force_n[0], tracks.soil_force_n[1],                  # port/stbd force
+            currents[0], currents[1],
+            act.port_prop_pct, act.stbd_prop_pct,                            # prop cmd
+            thrust[0], thrust[1], prop_i[0], prop_i[1],                      # thrust, current
+            battery, volume, w_eff,                             # battery, volume, eff. weight
+            (max(self._weight - self._rho_g * volume, 0.0) / self._weight   # on the tracks
+             if touching else 0.0),
+            beach.distance_along_slope_m(self.x),                            # waterline dist.
+            math.atan(abs(beach.gradient(self.x))), ground,                  # slope, ground
+            eta[0], eta[0] - ground,                                         # wave, water depth
+            fore, aft, sounder, self._medium(touching, volume),
+            c * st.wave_fx_n + s * st.wave_fy_n, touching)        # wave surge force, contact

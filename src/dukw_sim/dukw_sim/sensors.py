@@ -17,6 +17,7 @@ ENU. Errors of the IMU's attitude and of the DGPS position drift slowly
 from __future__ import annotations
 
 import math
+import dataclasses
 from dataclasses import dataclass
 from enum import IntFlag
 from typing import Mapping
@@ -207,6 +208,30 @@ def _positive(params: Mapping[str, ParamValue], name: str) -> float:
     if value <= 0:
         raise ConfigError(f'parameter {name!r} must be > 0, got {value}')
     return value
+
+
+def positional_builder(cls: type):
+    """A function building ``cls`` (a frozen, slotted dataclass) from all its fields given
+    positionally, about 4x cheaper than its __init__ (which sets each field through
+    object.__setattr__): an unfrozen slotted twin with the same fields (so the same slot
+    layout) is built and takes ``cls`` as its class. The result is an ordinary ``cls``:
+    equal to ``cls(*values)``, frozen, hashable. No defaults and no __post_init__ checks:
+    for the sensor models' own readings, whose values are floats they computed."""
+    if not dataclasses.is_dataclass(cls) or '__slots__' not in vars(cls):
+        raise TypeError(f'{cls.__name__} is not a slotted dataclass')
+    twin = dataclasses.make_dataclass(
+        f'_{cls.__name__}Fields', [(f.name, f.type) for f in dataclasses.fields(cls)],
+        slots=True)
+
+    def build(*values):
+        obj = twin(*values)
+        obj.__class__ = cls
+        return obj
+    return build
+
+
+_imu_sample = positional_builder(ImuSample)
+_motor_side = positional_builder(MotorSide)
 
 
 # ----------------------------------------------------------------------------- helpers
@@ -430,13 +455,12 @@ class SensorModel:
         bias, g = self._gyro_bias, noise.gyro_std_rps
         sx, sy, sz = noise.accel_x_std_mps2, noise.accel_y_std_mps2, noise.accel_z_std_mps2
         head2, g2, att2, accel_var = self._imu_var
-        return ImuSample(
+        return _imu_sample(      # ImuSample's fields in order (variances: yaw, yaw rate,
+            # roll, pitch, roll rate, pitch rate, accel)
             truth.t_s, truth.roll_rad + err[0], truth.pitch_rad + err[1], truth.yaw_rad + err[2],
             wx + bias[0] + g * d[0], wy + bias[1] + g * d[1], wz + bias[2] + g * d[2],
             fx + sx * d[3], fy + sy * d[4], fz + sz * d[5],
-            yaw_var_rad2=head2, yaw_rate_var_rps2=g2, roll_var_rad2=att2,
-            pitch_var_rad2=att2, roll_rate_var_rps2=g2, pitch_rate_var_rps2=g2,
-            accel_var_m2ps4=accel_var)
+            head2, g2, att2, att2, g2, g2, accel_var)
 
     def antenna_enu(self, truth: Truth) -> tuple[float, float, float]:
         """True position of the GPS antenna in odom (ENU), m: base_link + R (0, 0, h)."""
@@ -528,7 +552,7 @@ class SensorModel:
             flags = channel.update(dt, currents[i], stalling, voltage, under_v)
             current = currents[i] + noise.current_std_a * d[3 * i]
             speed = 0.0 if speeds is None else true_speed + noise.speed_std_mps * d[3 * i + 1]
-            sides.append(MotorSide(
+            sides.append(_motor_side(      # MotorSide's fields in order
                 commands[i], current, speed, force_n(current, commands[i]),
                 voltage + noise.voltage_std_v * d[3 * i + 2], channel.temperature_c,
                 flags, fault_names(flags)))
