@@ -184,7 +184,8 @@ class SimCore:
         self._lat_s = [self._track_len * ((j + 0.5) / LATERAL_POINTS - 0.5)
                        for j in range(LATERAL_POINTS)]
         # strips over the tracks' contact length: where the surf wets the tracks
-        self._track_strips = np.abs(self.hull.station_x_m) <= self._track_len / 2.0
+        self._track_strips = np.flatnonzero(np.abs(self.hull.station_x_m)
+                                            <= self._track_len / 2.0)
         self._wave_lever_z = params.wave_moments.transverse_force_z_m - self._kg
         self._no_moments = WaveMoments(0.0, 0.0, 0.0)
         self._external = (0.0, 0.0, 0.0)
@@ -397,8 +398,9 @@ class SimCore:
             targets[0] -= math.copysign(min(abs(targets[0]), self._port_droop_mps), targets[0])
         alpha = min(self.dt_s / land.speed_loop_time_constant_s, 1.0)
         max_dv = land.speed_loop_accel_mps2 * self.dt_s
-        self.ref = [self.ref[i] + max(-max_dv, min(max_dv, (targets[i] - self.ref[i]) * alpha))
-                    for i in range(2)]
+        ref = self.ref
+        self.ref = [ref[0] + max(-max_dv, min(max_dv, (targets[0] - ref[0]) * alpha)),
+                    ref[1] + max(-max_dv, min(max_dv, (targets[1] - ref[1]) * alpha))]
         return targets
 
     def _track_drives(self, act: Actuation, u_rel: float, w_eff: float,
@@ -406,26 +408,25 @@ class SimCore:
         """The track drives this step: speed loops, friction, paddling, soil contact."""
         p, drive = self.params, self.vehicle.drivetrain
         targets = self._advance_speed_refs(act)
+        ref = self.ref
         ground = (self.u - self.r * self._half_sep, self.u + self.r * self._half_sep)
         mean_depth = float(depths.sum()) / depths.size         # depths.mean(), same bits
         track_imm = min(max(mean_depth / self.seakeeping.equilibrium_depth_m, 0.0), 1.0)
-        others = []
-        paddle = []
-        for i in range(2):
-            # a loaded loop's speed follows the load: take its reference (no feedback chatter)
-            ts = self.ref[i] if math.isfinite(self._loop_k) else self.track_speed[i]
-            fric = drivetrain_friction_n(
-                drive.friction_n + (drive.port_extra_friction_n if i == 0 else 0.0), ts,
-                self.ref[i], p.land.breakaway_friction_ratio)
-            pad = track_paddle_n(p.water.track_paddle_coeff_n_per_mps2, self.ref[i], u_rel,
-                                 track_imm)
-            paddle.append(pad)
-            others.append(fric + pad)
+        # a loaded loop's speed follows the load: take its reference (no feedback chatter)
+        speeds = ref if math.isfinite(self._loop_k) else self.track_speed
+        breakaway, paddle_coeff = p.land.breakaway_friction_ratio, \
+            p.water.track_paddle_coeff_n_per_mps2
+        paddle = [track_paddle_n(paddle_coeff, ref[0], u_rel, track_imm),
+                  track_paddle_n(paddle_coeff, ref[1], u_rel, track_imm)]
+        others = [drivetrain_friction_n(drive.friction_n + drive.port_extra_friction_n,
+                                        speeds[0], ref[0], breakaway) + paddle[0],
+                  drivetrain_friction_n(drive.friction_n, speeds[1], ref[1], breakaway)
+                  + paddle[1]]
         contact = self._track_contact(w_eff)
         # the speed loops give under load; at a zero command they hold the track (brake)
         loop_k = (self._loop_k if targets[0] != 0.0 else math.inf,
                   self._loop_k if targets[1] != 0.0 else math.inf)
-        lin = linearise(contact, tuple(self.ref), ground, tuple(others), loop_k,
+        lin = linearise(contact, tuple(ref), ground, tuple(others), loop_k,
                         tuple(self.track_speed))
         return _Drives(ground, others, paddle, loop_k, contact, lin)
 
@@ -477,9 +478,9 @@ class SimCore:
         hydro = self._hydro()
         if self._over_tracks_of is not hydro:      # once per pose: contact, then resistance
             px, water = hydro[:2]
-            n = self._n_stations
-            self._over_tracks = (water.elevation_m[:n]
-                                 - self.world.beach.heights_m(px[:n]))[self._track_strips]
+            strips = self._track_strips               # the points' indices, all below n
+            self._over_tracks = (water.elevation_m[strips]
+                                 - self.world.beach.heights_m(px[strips]))
             self._over_tracks_of = hydro
         return self._over_tracks
 
@@ -525,16 +526,18 @@ class SimCore:
         others, contact, loop_k = drives.others, drives.contact, drives.loop_k
         self.u, self.v, self.r = u0 + du, v0 + dv, r0 + dr
         ground_new = (self.u - self.r * half, self.u + self.r * half)
-        speeds = [motor_limited_speed(contact, self.ref[i], ground_new[i], new[i])
-                  if limited[i] else self._loaded_speed(i, new[i] + others[i], loop_k[i])
-                  for i in range(2)]
+        speeds = [motor_limited_speed(contact, self.ref[0], ground_new[0], new[0])
+                  if limited[0] else self._loaded_speed(0, new[0] + others[0], loop_k[0]),
+                  motor_limited_speed(contact, self.ref[1], ground_new[1], new[1])
+                  if limited[1] else self._loaded_speed(1, new[1] + others[1], loop_k[1])]
         self.track_speed = speeds
-        slips = [traction.slip_f(speeds[i], ground_new[i]) for i in range(2)]
+        slips = [traction.slip_f(speeds[0], ground_new[0]),
+                 traction.slip_f(speeds[1], ground_new[1])]
         c, s = yaw_cs
         self.yaw = (self.yaw + dt * self.r + math.pi) % (2.0 * math.pi) - math.pi
         self.x += dt * (c * self.u - s * self.v)
         self.y += dt * (s * self.u + c * self.v)
-        return TrackState(speeds, new, [new[i] + others[i] for i in range(2)], slips)
+        return TrackState(speeds, new, [new[0] + others[0], new[1] + others[1]], slips)
 
     def _solve_surge_yaw(self, base: tuple, drives: _Drives):
         """Surge and yaw-rate change, implicit in the soil forces: Newton passes, each
