@@ -748,11 +748,12 @@ class SimCore:
         drive = self.vehicle.drivetrain
         speeds, motor = tracks.track_speed_mps, tracks.motor_force_n
         gain = drive.track_force_gain_n_per_a
-        currents = [motor[i] / gain
-                    + drive.no_load_current_a * math.tanh(speeds[i] / drive.friction_fade_mps)
-                    for i in range(2)]
-        prop_i = [self.params.water.prop_max_current_a
-                  * min(abs(thrust[i]) / drive.max_prop_thrust_n, 1.0) ** 1.5 for i in range(2)]
+        no_load, fade = drive.no_load_current_a, drive.friction_fade_mps
+        currents = [motor[0] / gain + no_load * math.tanh(speeds[0] / fade),
+                    motor[1] / gain + no_load * math.tanh(speeds[1] / fade)]
+        max_i, max_thrust = self.params.water.prop_max_current_a, drive.max_prop_thrust_n
+        prop_i = [max_i * min(abs(thrust[0]) / max_thrust, 1.0) ** 1.5,
+                  max_i * min(abs(thrust[1]) / max_thrust, 1.0) ** 1.5]
         battery = drive.motor_voltage_v - self.params.battery_internal_resistance_ohm * (
             abs(currents[0]) + abs(currents[1]) + prop_i[0] + prop_i[1])
         return currents, prop_i, battery
