@@ -201,6 +201,7 @@ class SimCore:
         # the strips' rows 1, x, y, x^2 + y^2: their area-weighted sums (forces.strip_sums)
         self._strip_basis = strip_basis(self.hull.station_x_m, self.hull.station_y_m)
         self._strip_tilt = np.column_stack([-self.hull.station_x_m, self.hull.station_y_m])
+        self._tilt_sines = np.zeros(2)
         self._wave_a2 = float(np.sum(self.world.waves.amplitude_m ** 2))
         self.reset()
 
@@ -297,7 +298,9 @@ class SimCore:
     def _strip_depths(self, eta: np.ndarray, z_cg: float, pitch: float,
                       roll: float) -> np.ndarray:
         # eta - (z_cg + bottom - x sin(pitch) + y sin(roll)): one product for the tilt
-        depths = eta[:self._n_stations] - self._strip_tilt @ (math.sin(pitch), math.sin(roll))
+        tilt = self._tilt_sines                  # (sin(pitch), sin(roll)), kept as an array
+        tilt[0], tilt[1] = math.sin(pitch), math.sin(roll)
+        depths = eta[:self._n_stations] - self._strip_tilt @ tilt
         depths -= z_cg + self.hull.bottom_above_cg_m
         return depths
 

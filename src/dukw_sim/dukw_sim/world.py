@@ -22,6 +22,7 @@ import numpy as np
 GRAVITY_MPS2 = 9.81
 # np.interp without its Python wrapper (real values: the wrapper calls this, same result)
 _interp = getattr(getattr(np, '_core', None), 'multiarray', np).interp
+_REACH_MARGIN_M = 1e-6     # a point's |R b| against its rounded odom x
 _MIN_KINEMATIC_DEPTH_M = 0.05
 
 
@@ -286,6 +287,8 @@ class World:
         self._rigid_coef = np.zeros((3, 4))
         self._rigid_coef[2, 2] = 1.0
         self._rigid_phase = np.zeros((4, waves.count))
+        self._reach_of: np.ndarray | None = None      # sample_rigid's rows, and their reach
+        self._reach_m = math.inf
         self._rigid_phase[3] = -0.5 * math.pi
         self._rigid_odom = np.zeros(4)
         self._transfer_key: tuple[float, float] | None = None
@@ -404,7 +407,11 @@ class World:
         odom[0], odom[1], odom[2] = cos_yaw, -sin_yaw, x_m
         px = rows @ odom
         kin_points = rows.shape[0] - n
-        if self._calm or px[:n].max() <= 0.0:     # calm, or all on the sand: no wave
+        if rows is not self._reach_of:            # the points' farthest reach from the origin
+            self._reach_m = float(np.hypot(rows[:, 0], rows[:, 1]).max()) + _REACH_MARGIN_M
+            self._reach_of = rows
+        seaward_x = x_m - self._reach_m           # no point is nearer the beach than this
+        if self._calm or (seaward_x <= 0.0 and px[:n].max() <= 0.0):  # calm, or on the sand
             kin = np.zeros(kin_points)
             return px, WaterSample(np.zeros(n), kin, kin, kin, kin)
         coef = self._rigid_coef
@@ -415,18 +422,21 @@ class World:
         np.matmul(coef, self._rigid_waves, out=phase[:3])
         np.remainder(phase[2], 2.0 * math.pi, out=phase[2])
         trig = np.cos(rows @ phase)                 # cos on the first n rows, then sin
-        return px, self._combine(trig, px, n, kin_points, kin_height_m)
+        # every point where the breaking cap is 1 (np.interp gives fp[-1] exactly there)
+        uncapped = seaward_x >= self._cap_x[1] and self._cap[1] == 1.0
+        return px, self._combine(trig, px, n, kin_points, kin_height_m, uncapped)
 
     def _combine(self, trig: np.ndarray, row_x: np.ndarray, n: int, kin_points: int,
-                 kin_height_m: float) -> WaterSample:
-        """Elevation and kinematics from the rows' cosines (then sines) of the phases."""
-        factor = _interp(row_x, self._cap_x, self._cap)
+                 kin_height_m: float, uncapped: bool = False) -> WaterSample:
+        """Elevation and kinematics from the rows' cosines (then sines) of the phases
+        (``uncapped``: every row where the breaking cap is 1, the factor is skipped)."""
         if kin_points:
             self._set_transfer(row_x[:kin_points], kin_height_m)
             out = trig @ self._weights
         else:
             out = trig @ self._weights[:, :1]
-        out *= factor[:, None]
+        if not uncapped:
+            out *= _interp(row_x, self._cap_x, self._cap)[:, None]
         if not kin_points:
             kin = np.zeros(0)
             return WaterSample(out[:n, 0], kin, kin, kin, kin)
