@@ -155,7 +155,10 @@ def test_rigid_body_sample_is_the_sample_at_the_moved_points():
                                            spreading_exponent_s=10.0, directions=6))
     bx, by = rng.uniform(-1.5, 1.5, 10), rng.uniform(-0.5, 0.5, 10)
     rows = world.rigid_rows(bx, by, 6)
-    poses = ((12.0, 0.3, 2.9, 250.0), (3.0, -1.0, -0.4, 7.31), (-3.0, 0.0, 0.1, 1.0))
+    full_cap_x = float(world._cap_x[1])        # seaward of this the breaking cap is 1
+    poses = ((12.0, 0.3, 2.9, 250.0), (3.0, -1.0, -0.4, 7.31), (-3.0, 0.0, 0.1, 1.0),
+             (0.4, 0.0, 1.0, 3.0),                                    # astride the waterline
+             (full_cap_x + 0.3, 0.0, 0.2, 9.0), (full_cap_x + 1.7, 0.0, 2.0, 9.0))  # cap's end
     for x0, y0, yaw, t in poses:
         c, s = math.cos(yaw), math.sin(yaw)
         px, py = x0 + c * bx - s * by, y0 + s * bx + c * by
@@ -166,7 +169,7 @@ def test_rigid_body_sample_is_the_sample_at_the_moved_points():
         for got, want in zip(rigid, plain, strict=True):
             assert got.shape == want.shape
             assert np.allclose(got, want, rtol=0.0, atol=1e-12)
-        assert np.any(rigid.elevation_m != 0.0) == (x0 > 0.0)   # the last: all on the sand
+        assert np.any(rigid.elevation_m != 0.0) == (x0 != -3.0)  # that one: all on the sand
     with pytest.raises(ValueError):
         world.rigid_rows(bx, by, 11)
 
