@@ -347,8 +347,8 @@ class SimCore:
         dt = self.dt_s
         u0, v0, hv0 = self.u, self.v, self.heave_vel
         c, s = math.cos(self.yaw), math.sin(self.yaw)
-        imm, w_eff = self._contact_and_immersion()
-        _, water, depths, areas, sums = self._hydro()
+        imm, w_eff, hydro = self._contact_and_immersion()
+        _, water, depths, areas, sums = hydro
         body = self.vehicle.body
         waves = wave_forcing(self.world.calm, areas, self.hull.strip_length_m, water,
                              self.params.waves, body.water_density_kgpm3, self._rho_g,
@@ -375,22 +375,23 @@ class SimCore:
                                                        waves.fy_n, accel))
         return self.truth
 
-    def _contact_and_immersion(self) -> tuple[Immersion, float]:
+    def _contact_and_immersion(self) -> tuple[Immersion, float, _Hydro]:
         """Put a grounded vehicle on the beach, take the water's buoyancy, lift off when it
-        carries the weight; return the immersion and the weight on the tracks, N."""
+        carries the weight; return the immersion, the weight on the tracks, N, and the water
+        at the pose."""
         gz, gpitch, groll, slope = self._ground_pose()
         if self.in_contact:
             self.z_cg, self.pitch, self.roll = gz + self._kg, gpitch, groll
-        areas, sums = self._hydro()[3:]
-        imm = immersion(areas, self.hull.strip_length_m, self._rho_g, self._afloat_volume,
-                        sums.area_m2)
+        hydro = self._hydro()
+        imm = immersion(hydro.areas, self.hull.strip_length_m, self._rho_g,
+                        self._afloat_volume, hydro.sums.area_m2)
         if self.in_contact and imm.buoyancy_n >= self._weight:
             self.in_contact = False
         if not (self.in_contact or self.grazing):
-            return imm, 0.0
+            return imm, 0.0, hydro
         return imm, max(traction.effective_weight_n(
             self._weight, imm.volume_m3, slope, self.vehicle.body.water_density_kgpm3,
-            self._g), 0.0)
+            self._g), 0.0), hydro
 
     def _advance_speed_refs(self, act: Actuation) -> list[float]:
         """Move the track speed loops' references toward the commands; return the targets."""
@@ -820,7 +821,7 @@ class SimCore:
             (max(self._weight - self._rho_g * volume, 0.0) / self._weight   # on the tracks
              if touching else 0.0),
             beach.distance_along_slope_m(self.x),                            # waterline dist.
-            math.atan(abs(beach.gradient(self.x))), ground,                  # slope, ground
+            self._ground_pose()[3], ground,           # slope (atan |gradient|, kept), ground
             eta[0], eta[0] - ground,                                         # wave, water depth
             fore, aft, sounder, self._medium(touching, volume),
             c * st.wave_fx_n + s * st.wave_fy_n, touching)        # wave surge force, contact

@@ -232,6 +232,10 @@ def positional_builder(cls: type):
 
 _imu_sample = positional_builder(ImuSample)
 _motor_side = positional_builder(MotorSide)
+_gps_fix = positional_builder(GpsFix)
+_gps_velocity = positional_builder(GpsVelocity)
+_water_contact = positional_builder(WaterContact)
+_depth_reading = positional_builder(DepthReading)
 
 
 # ----------------------------------------------------------------------------- helpers
@@ -479,8 +483,7 @@ class SensorModel:
                                                 datum.latitude_deg, datum.longitude_deg,
                                                 datum.altitude_m)
         h2, v2 = noise.gps_horizontal_std_m ** 2, noise.gps_vertical_std_m ** 2
-        return GpsFix(truth.t_s, lat, lon, alt, horizontal_var_m2=h2, valid=True,
-                      vertical_var_m2=v2)
+        return _gps_fix(truth.t_s, lat, lon, alt, h2, True, v2)   # h. var, valid, v. var
 
     def gps_velocity(self, truth: Truth) -> GpsVelocity:
         """DGPS velocity of the antenna, ENU: body velocity plus w x r, rotated; white noise."""
@@ -489,8 +492,8 @@ class SensorModel:
         u, v = sensor_point_velocity_body(truth.surge_mps, truth.sway_mps,
                                           truth.roll_rate_rps, truth.pitch_rate_rps, h)
         cy, sy = math.cos(truth.yaw_rad), math.sin(truth.yaw_rad)
-        return GpsVelocity(truth.t_s, cy * u - sy * v + s * d[0], sy * u + cy * v + s * d[1],
-                           var_mps2=s * s, up_mps=truth.heave_mps + s * d[2], up_var_mps2=s * s)
+        return _gps_velocity(truth.t_s, cy * u - sy * v + s * d[0], sy * u + cy * v + s * d[1],
+                             s * s, truth.heave_mps + s * d[2], s * s)   # var, up, up var
 
     def water(self, truth: Truth) -> WaterContact:
         """Water contact: the level ramps 0 -> 1 across the lead gap around the sensor point."""
@@ -499,8 +502,8 @@ class SensorModel:
         gap = max(water.lead_gap_m, 1e-6)
         fore = _clip01(0.5 + truth.fore_sensor_depth_m / gap + s * d[0])
         aft = _clip01(0.5 + truth.aft_sensor_depth_m / gap + s * d[1])
-        return WaterContact(truth.t_s, self._fore.update(fore >= water.wet_level),
-                            self._aft.update(aft >= water.wet_level), fore, aft)
+        return _water_contact(truth.t_s, self._fore.update(fore >= water.wet_level),
+                              self._aft.update(aft >= water.wet_level), fore, aft)
 
     def depth(self, truth: Truth) -> DepthReading:
         """Depth below the transducer; invalid (NaN) out of water or shallower than the minimum."""
@@ -509,8 +512,8 @@ class SensorModel:
         valid = (truth.sounder_depth_m > 0.0
                  and truth.water_depth_m > cfg.mounts.depth_sounder_min_m)
         depth_m = truth.sounder_depth_m + cfg.noise.depth_std_m * d[0] if valid else math.nan
-        return DepthReading(truth.t_s, valid, depth_m, cfg.depth.offset_m,
-                            cfg.depth.water_temp_c)
+        return _depth_reading(truth.t_s, valid, depth_m, cfg.depth.offset_m,
+                              cfg.depth.water_temp_c)
 
     def tracks(self, truth: Truth) -> DriveStatus:
         """The tracks' controller: command, current, pack voltage, belt speed, force = I x gain."""
