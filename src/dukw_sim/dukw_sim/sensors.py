@@ -236,6 +236,7 @@ _gps_fix = positional_builder(GpsFix)
 _gps_velocity = positional_builder(GpsVelocity)
 _water_contact = positional_builder(WaterContact)
 _depth_reading = positional_builder(DepthReading)
+_drive_status = positional_builder(DriveStatus)    # drive: 'tracks' or 'props', ours below
 
 
 # ----------------------------------------------------------------------------- helpers
@@ -559,4 +560,4 @@ class SensorModel:
                 commands[i], current, speed, force_n(current, commands[i]),
                 voltage + noise.voltage_std_v * d[3 * i + 2], channel.temperature_c,
                 flags, fault_names(flags)))
-        return DriveStatus(truth.t_s, sides[0], sides[1], True, drive)
+        return _drive_status(truth.t_s, sides[0], sides[1], True, drive)   # connected
