@@ -300,7 +300,7 @@ class SimCore:
         # eta - (z_cg + bottom - x sin(pitch) + y sin(roll)): one product for the tilt
         tilt = self._tilt_sines                  # (sin(pitch), sin(roll)), kept as an array
         tilt[0], tilt[1] = math.sin(pitch), math.sin(roll)
-        depths = eta[:self._n_stations] - self._strip_tilt @ tilt
+        depths = eta[:self._n_stations] - np.dot(self._strip_tilt, tilt)   # dot: matmul's bits
         depths -= z_cg + self.hull.bottom_above_cg_m
         return depths
 

@@ -23,6 +23,9 @@ GRAVITY_MPS2 = 9.81
 # np.interp without its Python wrapper (real values: the wrapper calls this, same result)
 _interp = getattr(getattr(np, '_core', None), 'multiarray', np).interp
 _REACH_MARGIN_M = 1e-6     # a point's |R b| against its rounded odom x
+# np.dot, not @, for the per-step small products: the same BLAS call (same bits on these
+# contiguous float arrays) without matmul's ufunc overhead, ~0.5 us less each
+_dot = np.dot
 _MIN_KINEMATIC_DEPTH_M = 0.05
 
 
@@ -405,7 +408,7 @@ class World:
         """
         odom = self._rigid_odom
         odom[0], odom[1], odom[2] = cos_yaw, -sin_yaw, x_m
-        px = rows @ odom
+        px = _dot(rows, odom)
         kin_points = rows.shape[0] - n
         if rows is not self._reach_of:            # the points' farthest reach from the origin
             self._reach_m = float(np.hypot(rows[:, 0], rows[:, 1]).max()) + _REACH_MARGIN_M
@@ -419,9 +422,9 @@ class World:
         coef[0, 1], coef[1, 0] = sin_yaw, -sin_yaw
         coef[2, 0], coef[2, 1], coef[2, 3] = x_m, y_m, -t_s
         phase = self._rigid_phase
-        np.matmul(coef, self._rigid_waves, out=phase[:3])
+        _dot(coef, self._rigid_waves, out=phase[:3])
         np.remainder(phase[2], 2.0 * math.pi, out=phase[2])
-        trig = np.cos(rows @ phase)                 # cos on the first n rows, then sin
+        trig = np.cos(_dot(rows, phase))            # cos on the first n rows, then sin
         # every point where the breaking cap is 1 (np.interp gives fp[-1] exactly there)
         uncapped = seaward_x >= self._cap_x[1] and self._cap[1] == 1.0
         return px, self._combine(trig, px, n, kin_points, kin_height_m, uncapped)
@@ -432,7 +435,7 @@ class World:
         (``uncapped``: every row where the breaking cap is 1, the factor is skipped)."""
         if kin_points:
             self._set_transfer(row_x[:kin_points], kin_height_m)
-            out = trig @ self._weights
+            out = _dot(trig, self._weights)
         else:
             out = trig @ self._weights[:, :1]
         if not uncapped:
