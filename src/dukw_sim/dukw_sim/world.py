@@ -291,6 +291,7 @@ class World:
         self._rigid_coef[2, 2] = 1.0
         self._rigid_phase = np.zeros((4, waves.count))
         self._reach_of: np.ndarray | None = None      # sample_rigid's rows, and their reach
+        self._offshore_depth: dict[int, float] = {}   # points over the sea floor: their depth
         self._reach_m = math.inf
         self._rigid_phase[3] = -0.5 * math.pi
         self._rigid_odom = np.zeros(4)
@@ -427,14 +428,17 @@ class World:
         trig = np.cos(_dot(rows, phase))            # cos on the first n rows, then sin
         # every point where the breaking cap is 1 (np.interp gives fp[-1] exactly there)
         uncapped = seaward_x >= self._cap_x[1] and self._cap[1] == 1.0
-        return px, self._combine(trig, px, n, kin_points, kin_height_m, uncapped)
+        return px, self._combine(trig, px, n, kin_points, kin_height_m, uncapped,
+                                 seaward_x >= self._still_x[1])
 
     def _combine(self, trig: np.ndarray, row_x: np.ndarray, n: int, kin_points: int,
-                 kin_height_m: float, uncapped: bool = False) -> WaterSample:
+                 kin_height_m: float, uncapped: bool = False,
+                 offshore: bool = False) -> WaterSample:
         """Elevation and kinematics from the rows' cosines (then sines) of the phases
-        (``uncapped``: every row where the breaking cap is 1, the factor is skipped)."""
+        (``uncapped``: every row where the breaking cap is 1, the factor is skipped;
+        ``offshore``: every row over the flat sea floor)."""
         if kin_points:
-            self._set_transfer(row_x[:kin_points], kin_height_m)
+            self._set_transfer(row_x[:kin_points], kin_height_m, offshore)
             out = _dot(trig, self._weights)
         else:
             out = trig @ self._weights[:, :1]
@@ -446,10 +450,17 @@ class World:
         return WaterSample(out[:n, 0], out[:kin_points, 1], out[:kin_points, 2], out[n:, 3],
                            out[n:, 4])
 
-    def _set_transfer(self, x_kin: np.ndarray, kin_height_m: float) -> None:
-        """Kinematic weights times cosh k(z + d) / sinh k d at the points' mean still depth."""
-        depth = float(_interp(x_kin, self._still_x, self._still_depth).sum()) / x_kin.size
-        depth = max(depth, _MIN_KINEMATIC_DEPTH_M)
+    def _set_transfer(self, x_kin: np.ndarray, kin_height_m: float,
+                      offshore: bool = False) -> None:
+        """Kinematic weights times cosh k(z + d) / sinh k d at the points' mean still depth
+        (``offshore``: all over the flat sea floor, where it is the same for any such points,
+        np.interp giving the floor's depth exactly: kept per number of points)."""
+        depth = self._offshore_depth.get(x_kin.size) if offshore else None
+        if depth is None:
+            depth = float(_interp(x_kin, self._still_x, self._still_depth).sum()) / x_kin.size
+            depth = max(depth, _MIN_KINEMATIC_DEPTH_M)
+            if offshore:
+                self._offshore_depth[x_kin.size] = depth
         zc = min(max(kin_height_m, -depth), 0.0)
         if (zc, depth) == self._transfer_key:     # e.g. the hull above the water
             return

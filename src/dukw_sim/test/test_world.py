@@ -158,7 +158,9 @@ def test_rigid_body_sample_is_the_sample_at_the_moved_points():
     full_cap_x = float(world._cap_x[1])        # seaward of this the breaking cap is 1
     poses = ((12.0, 0.3, 2.9, 250.0), (3.0, -1.0, -0.4, 7.31), (-3.0, 0.0, 0.1, 1.0),
              (0.4, 0.0, 1.0, 3.0),                                    # astride the waterline
-             (full_cap_x + 0.3, 0.0, 0.2, 9.0), (full_cap_x + 1.7, 0.0, 2.0, 9.0))  # cap's end
+             (full_cap_x + 0.3, 0.0, 0.2, 9.0), (full_cap_x + 1.7, 0.0, 2.0, 9.0),  # cap's end
+             (world.beach.sea_floor_x_m + 1.7, 0.0, 0.5, 2.0),     # over the flat sea floor,
+             (world.beach.sea_floor_x_m + 2.0, 0.4, 0.1, 2.5))     # twice (its depth kept)
     for x0, y0, yaw, t in poses:
         c, s = math.cos(yaw), math.sin(yaw)
         px, py = x0 + c * bx - s * by, y0 + s * bx + c * by
