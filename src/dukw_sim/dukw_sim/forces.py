@@ -108,7 +108,7 @@ def strip_sums(areas_m2: np.ndarray, water: WaterSample, basis: np.ndarray) -> S
     n = areas_m2.size
     kin = np.array((basis[0], water.velocity_x_mps[:n], water.velocity_y_mps[:n],
                     water.accel_x_mps2[:n], water.accel_y_mps2[:n]))
-    return StripSums(*((basis * areas_m2) @ kin.T).ravel().tolist())
+    return StripSums(*np.dot(basis * areas_m2, kin.T).ravel().tolist())   # dot: @ bits, cheaper
 
 
 def _sums_of(sums: StripSums | None, areas_m2: np.ndarray, water: WaterSample,
