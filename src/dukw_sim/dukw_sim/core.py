@@ -47,6 +47,7 @@ __all__ = ['Actuation', 'SimCore', 'SimParams']
 _LAND_FRACTION = 0.02          # submerged share of the afloat volume below which: LAND
 _NEWTON_PASSES = 3             # implicit track-soil solve
 _NEWTON_TOL_MPS = 2e-4
+_CLEAR_MARGIN_M = 1e-9          # touchdown's shortcut: clear of the sand by more than this
 
 
 class TrackState(NamedTuple):
@@ -379,8 +380,8 @@ class SimCore:
         """Put a grounded vehicle on the beach, take the water's buoyancy, lift off when it
         carries the weight; return the immersion, the weight on the tracks, N, and the water
         at the pose."""
-        gz, gpitch, groll, slope = self._ground_pose()
         if self.in_contact:
+            gz, gpitch, groll, _ = self._ground_pose()
             self.z_cg, self.pitch, self.roll = gz + self._kg, gpitch, groll
         hydro = self._hydro()
         imm = immersion(hydro.areas, self.hull.strip_length_m, self._rho_g,
@@ -390,7 +391,8 @@ class SimCore:
         if not (self.in_contact or self.grazing):
             return imm, 0.0, hydro
         return imm, max(traction.effective_weight_n(
-            self._weight, imm.volume_m3, slope, self.vehicle.body.water_density_kgpm3,
+            self._weight, imm.volume_m3, self._ground_pose()[3],
+            self.vehicle.body.water_density_kgpm3,
             self._g), 0.0), hydro
 
     def _advance_speed_refs(self, act: Actuation) -> list[float]:
@@ -718,9 +720,16 @@ class SimCore:
         stopped, it goes on pitching and rolling afloat, and the sand carries what the water
         does not (the weight less the buoyancy, on the tracks).
         """
-        gz, gpitch, groll, _ = self._ground_pose()
         base = self.z_cg - self._kg
         half = self._track_len / 2.0
+        # the beach is monotonic in x: the ground under the tracks (the mean of its heights
+        # half a track length fore and aft) is at most the higher of those at x -+ half; the
+        # lowest track point is at least base - half - half_sep: clear above it, no contact
+        beach = self.world.beach
+        if base - half - self._half_sep > max(beach.height_m(self.x - half),
+                                              beach.height_m(self.x + half)) + _CLEAR_MARGIN_M:
+            return
+        gz, gpitch, groll, _ = self._ground_pose()
         lowest = base - half * abs(math.sin(self.pitch - gpitch)) \
             - self._half_sep * abs(math.sin(self.roll - groll))
         if lowest > gz:
@@ -821,7 +830,7 @@ class SimCore:
             (max(self._weight - self._rho_g * volume, 0.0) / self._weight   # on the tracks
              if touching else 0.0),
             beach.distance_along_slope_m(self.x),                            # waterline dist.
-            self._ground_pose()[3], ground,           # slope (atan |gradient|, kept), ground
+            math.atan(abs(beach.gradient(self.x))), ground,                  # slope, ground
             eta[0], eta[0] - ground,                                         # wave, water depth
             fore, aft, sounder, self._medium(touching, volume),
             c * st.wave_fx_n + s * st.wave_fy_n, touching)        # wave surge force, contact
