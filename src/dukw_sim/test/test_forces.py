@@ -9,8 +9,8 @@ import pytest
 from dukw_sim.core import SimCore
 from dukw_sim.forces import (Wrench, hydrodynamic_drag, lateral_resistance, mooring,
                              odom_force, propulsion, rolling_resistance, slope_gravity,
-                             saturated_share, sum_wrenches, surf_resistance, track_wetness,
-                             water_yaw_rate_rps, wave_moments)
+                             saturated_share, strip_basis, strip_sums, sum_wrenches,
+                             surf_resistance, track_wetness, water_yaw_rate_rps, wave_moments)
 from dukw_sim.world import WaterSample
 
 PARAMS = SimCore.from_config().params
@@ -198,3 +198,26 @@ def test_water_yaw_rate_is_the_rotation_of_the_water_over_the_immersed_hull(yaw_
     assert water_yaw_rate_rps(areas, shear, xs, ys, (1.0, 0.0)) > 0.0
     assert water_yaw_rate_rps(bow_dry, shear, xs, ys, (1.0, 0.0)) == 0.0
     assert water_yaw_rate_rps(np.zeros(6), water, xs, ys, (c, s)) == 0.0
+
+
+def test_strip_sums_are_the_area_weighted_sums_strip_by_strip():
+    """The one matrix product the wave forces, moments and water yaw rate read."""
+    rng = np.random.default_rng(2)
+    xs, ys, areas = rng.uniform(-1, 1, 6), rng.uniform(-0.5, 0.5, 6), rng.uniform(0, 0.06, 6)
+    kin = rng.normal(size=(4, 9))          # more points than strips: the strips come first
+    water = WaterSample(np.zeros(9), *kin)
+    sums = strip_sums(areas, water, strip_basis(xs, ys))
+    for weight, prefix in ((1.0, ''), (xs, 'x_'), (ys, 'y_'), (xs ** 2 + ys ** 2, 'r2_')):
+        for row, name in zip(kin, ('vx', 'vy', 'ax', 'ay'), strict=True):
+            want = math.fsum(areas * weight * row[:6])
+            assert getattr(sums, prefix + name) == pytest.approx(want, rel=1e-13, abs=1e-15)
+    assert sums.area_m2 == pytest.approx(math.fsum(areas), rel=1e-14)
+    assert sums.area_x_m3 == pytest.approx(math.fsum(areas * xs), rel=1e-13)
+    assert sums.area_y_m3 == pytest.approx(math.fsum(areas * ys), rel=1e-13)
+    assert sums.area_r2_m4 == pytest.approx(math.fsum(areas * (xs ** 2 + ys ** 2)), rel=1e-13)
+    # the functions give the same with the caller's sums as with their own
+    c, s = math.cos(0.7), math.sin(0.7)
+    assert water_yaw_rate_rps(areas, water, xs, ys, (c, s), sums) == \
+        water_yaw_rate_rps(areas, water, xs, ys, (c, s))
+    args = (False, areas, 0.3, water, PARAMS.waves, 1025.0, xs, ys, (c, s), -0.2)
+    assert wave_moments(*args, sums) == wave_moments(*args)
