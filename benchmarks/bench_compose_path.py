@@ -92,11 +92,11 @@ def one_pass(bag: Path, profile: str | None = None) -> dict[str, np.ndarray]:
 
 PROFILE_HEADER = """cProfile of the composed chain's path (a golden bag through its callbacks):
   python benchmarks/bench_compose_path.py --profile benchmarks/profiles/compose_path.txt
-The command goes out before the observers' work: in the IMU callback the EKF step,
-odometry() and the filled Odometry's publication, then the controller's step and
-tracks/cmd + props/cmd; only then the traction read (Estimate.traction, lazy), /tf
-and traction. rclpy publish (C: serialisation + Fast DDS write) is the largest
-single item; the EKF's add_imu the largest Python one."""
+The command goes out before the observers' work: in the IMU callback the EKF step and
+odometry(), the controller's step and tracks/cmd + props/cmd; only then the traction
+read (Estimate.traction, lazy), the filled Odometry's publication, /tf and traction.
+rclpy publish (C: serialisation + Fast DDS write) is the largest single item; the EKF's
+add_imu the largest Python one."""
 
 
 def main() -> None:

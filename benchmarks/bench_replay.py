@@ -120,13 +120,24 @@ Before issue 16's replay work the bag was opened twice (anchor pass + replay) an
 open (metadata.yaml and every topic's QoS YAML, pure-Python ruamel) was timed with the
 messages: 40-80 ms per open, more than a quarter of a 7 s bag's replay. Now: one open,
 timed apart (bag_io.BagReader, ReplayResult.open_s). Then (branch ekfperf) the estimator's
-hot paths: the track-force smoother without filterpy's generic calls (scipy block_diag
-per predict), each hull volume computed once per input and skipped when the hulls are
-clearly dry, scalar weights, the 2-D DGPS gate in closed form. What is left: the
-estimator (about 40 % of the CPU: traction's slip and Wong forces in dukw_model, the
-EKF's predict and updates, estimator._admit's checks, buoyancy in the water), rosbags'
-CDR decoding (~18 %) and MCAP reading (~11 %), the controller (~13 %), the comparisons
-(~5 %). bench_replay's 'bound' line gives the estimator-alone limit per bag."""
+hot paths. Then (branch i16replay, 2026-11-25) the replay's own work, results
+bit-identical (golden bags regenerate unchanged): outputs equal to the recording bit for
+bit are compared with one dict-view check; a core only visits the messages it uses;
+adapters dispatch by topic; the drive controller makes its hand PI gains once and
+SidePair.scaled(1.0) returns the pair. Reading and decoding are rosbags' (BagReader.messages
+over rosbags' Reader with the connections filtered once; Typestore.deserialize_cdr, its
+bound method taken once): a hand-written MCAP chunk reader and CDR decoder generator were
+faster (reading + decoding 37 -> 23 ms of land_to_sea) but were dropped for the project's
+library rule. Interleaved A/B against bdc8249 (04:28-04:33 UTC, CPU clock, best of 5 per
+run, eight rounds, load average 4-6): 19.9-24.2 k (median 22.8) -> 21.3-25.3 k (22.5)
+msg/s land_circle, 20.0-22.1 (21.4) -> 17.7-23.1 (21.7) land_to_sea, 20.4-23.2 (21.6) ->
+18.3-23.6 (21.2) sea_to_land: no difference the noise lets through. What limits it,
+measured: the estimator alone (the 'bound' line) is ~110 ms CPU of land_to_sea's ~240 ms
+(at most ~49 k msg/s with nothing else), so 50 k through all cores is out of reach
+without a cheaper estimator; of the rest: rosbags' CDR decoding (~24 ms, ~20 % here) and
+MCAP reading (~11 ms, ~11 % here), the estimator's message conversions and rows, the
+drive controller core (~13 ms) and its conversions, the mode manager, the comparisons
+and the replay loop."""
 
 ESTIMATOR_PROFILE_HEADER = """cProfile of the estimator alone (EkfRunner, odometry and
 traction read per estimate, as the replay does) on tests/golden/land_to_sea's inputs,

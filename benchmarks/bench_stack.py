@@ -1,27 +1,36 @@
 """Benchmark: the whole stack on the simulator at 100 Hz, as the main job runs it.
 
 Prints (no pass/fail):
-- latency from a sensor message to the actuator command it leads to, p50/p99/max;
-  target p99 <= 10 ms across processes;
+- latency from a sensor sample to the actuator command it leads to, p50/p90/p99/max and
+  its parts; targets (issue 16) p50 <= 1 ms, p99 <= 5 ms, aim 2 ms;
 - each node's CPU share of one core from /proc/<pid>/stat (utime + stime over the
   measuring window); target: the stack without the simulator <= 25 % of one core.
 
-Pairing (chain imu/data -> ekf_node -> odometry/filtered -> drive_controller_node ->
-tracks/cmd, props/cmd): an imu/data message with stamp S "leads to" the first
-tracks/cmd or props/cmd that this process receives after the first
-odometry/filtered whose stamp is >= S (the first estimate that can contain it).
-Latency = receive time of that command minus the sensor message's time. When the
-stamps are on the wall clock (sim without /clock), the sensor time is its stamp
-S; when the nodes run on the simulator's /clock (the main job's set-up), stamps
-are sim seconds, so the sensor time is the receive time of the imu/data message
-here, which leaves out its own delivery (~0.3 ms on this machine; the figure says
-which was used). Sensor messages no command followed within 100 ms count as lost.
+What the latency measures: from the simulator's publish call of an imu/data sample to
+the moment an actuator-side subscriber takes the tracks/cmd that sample led to. The
+stack runs with benchmarks/latency_trace on its PYTHONPATH (DUKW_LATENCY_TRACE): each
+process notes, on one monotonic clock, its publish calls and callbacks of the chain's
+topics and in which callback each publish ran, so each command is traced back to its
+sample exactly (tracks/cmd <- [odometry/filtered <-] imu/data), whichever the shape.
+The actuator side is this process's subscriber (an EventsExecutor doing nothing else: as
+the servo switch's driver on the boat); the simulator's own take, which waits until its
+step has published everything else, is printed beside it. The figure is split into the
+sample's delivery to the chain, the chain's work to the command's publish call, and the
+command's publish and delivery. Samples no command followed within 100 ms count as lost.
+(Before 2026-11-25 04:00 the latency started at this process's receipt of the imu/data
+message and ended at its receipt of the first command after the estimate: that left out
+the sample's delivery, about 0.2-0.7 ms.)
+
+The stack file's ``realtime_priority`` applies (the control chain under SCHED_FIFO, and
+then this process too, standing in for the servo switch's driver; the simulator 10 below
+the chain, as the boat's IMU and servo switch drivers: ``with_priorities``);
+``--normal-priority`` runs everything at normal priority, to see what the priority buys.
 
 With ``--cores 1`` the stack's node processes (all but the simulator) are pinned to one
 core with taskset (util-linux), as a stand-in for the boat's small computer.
 
     python benchmarks/bench_stack.py [--stack sim_composed [--stack sim]] [--duration 20]
-                                     [--warmup 5] [--cores 1]
+                                     [--warmup 5] [--cores 1] [--normal-priority]
 
 ``--stack`` chooses the bring-up shape: ``sim_composed`` (the main job's: the control chain
 as one process, dukw_bringup.compose) or ``sim`` (one process per node); by default both in
@@ -30,12 +39,14 @@ turn (the summary names the figures of ``sim``, ``, stack sim``).
 from __future__ import annotations
 
 import argparse
+import os
+import pickle
 import shutil
 import subprocess
-import os
 import sys
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -43,7 +54,7 @@ import numpy as np
 from dukw_bringup.bringup import Runner, load_stack, stack_path
 from dukw_bringup.mission import load_mission
 from dukw_bringup.run_setup import prepare_run
-from dukw_bringup.stack_metrics import cpu_seconds, pair_latencies
+from dukw_bringup.stack_metrics import chain_latencies, cpu_seconds
 from dukw_common.config import default_config_path
 from figures import report
 
@@ -51,37 +62,37 @@ LIVE_VIEW_NODE = 'live_view_node'   # the Foxglove view: an observer, not contro
 SIM_NODE = 'sim_node'
 #: measured in turn by default: the main job's composed shape, then one process per node
 DEFAULT_STACKS = ('sim_composed', 'sim')
+#: the tracer every process of the stack runs (sitecustomize on PYTHONPATH), and its switch
+TRACER_DIR = Path(__file__).resolve().parent / 'latency_trace'
+TRACE_ENV = 'DUKW_LATENCY_TRACE'
+#: the simulator's SCHED_FIFO priority this far below the chain's: the chain preempts it
+SIM_PRIORITY_BELOW = 10
 
 class Probe:
-    """Receives the chain's topics and notes (receive time, stamp) of each message."""
+    """The actuator side: takes tracks/cmd and notes (monotonic ns, stamp ns) of each."""
 
-    def __init__(self, overlay: Path) -> None:
+    def __init__(self, overlay: Path, priority: int) -> None:
+        """``priority``: SCHED_FIFO priority of this process, as the actuator's driver's."""
         import rclpy
         from dukw_msgs.msg import DiffCommand
-        from nav_msgs.msg import Odometry
         from rclpy.context import Context
-        from rclpy.executors import SingleThreadedExecutor
-        from sensor_msgs.msg import Imu
+        from rclpy.experimental import EventsExecutor
 
-        from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS
+        from dukw_common.node_tools import COMMAND_QOS
+        if priority:   # (before rclpy starts its threads: they inherit it)
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+        self.priority = priority
         self.context = Context()
         rclpy.init(args=['--ros-args', '--params-file', str(overlay)], context=self.context)
         self.node = rclpy.create_node('main_job', context=self.context)  # overlay: sim time
-        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor = EventsExecutor(context=self.context)
         self.executor.add_node(self.node)
-        self.records: dict[str, list[tuple[float, float]]] = {
-            'imu': [], 'odom': [], 'cmd': []}
-        self.recording = False
-        for topic, cls, key, qos in (('imu/data', Imu, 'imu', SENSOR_QOS),
-                                     ('odometry/filtered', Odometry, 'odom', SENSOR_QOS),
-                                     ('tracks/cmd', DiffCommand, 'cmd', COMMAND_QOS),
-                                     ('props/cmd', DiffCommand, 'cmd', COMMAND_QOS)):
-            self.node.create_subscription(cls, topic, lambda m, k=key: self._on(k, m), qos)
+        self.takes: list[tuple[int, int]] = []
+        self.node.create_subscription(DiffCommand, 'tracks/cmd', self._on, COMMAND_QOS)
 
-    def _on(self, key: str, msg) -> None:
-        if self.recording:
-            stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
-            self.records[key].append((time.time(), stamp))
+    def _on(self, msg) -> None:
+        stamp = msg.header.stamp
+        self.takes.append((time.monotonic_ns(), stamp.sec * 1_000_000_000 + stamp.nanosec))
 
     def spin(self, duration_s: float) -> None:
         deadline = time.monotonic() + duration_s
@@ -93,6 +104,77 @@ class Probe:
         self.executor.shutdown()
         self.node.destroy_node()
         rclpy.try_shutdown(context=self.context)
+        if self.priority:
+            os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
+
+
+def with_priorities(stack, normal: bool):
+    """The stack as measured: every process at normal priority (``normal``), or as its file
+    says plus the simulator under SCHED_FIFO just below the chain (SIM_PRIORITY_BELOW): it
+    stands in for the boat's IMU and servo switch drivers, which run under SCHED_FIFO; at
+    real-time factor 1 it is no hog (the stack files leave it out: at factor 0 it would be)."""
+    if normal:
+        return stack.at_normal_priority()
+    chain = max(n.realtime_priority for n in stack.nodes)
+
+    def priority(node) -> int:
+        if node.name == SIM_NODE and chain and not node.realtime_priority:
+            return max(1, chain - SIM_PRIORITY_BELOW)
+        return node.realtime_priority
+    return replace(stack, nodes=tuple(replace(n, realtime_priority=priority(n))
+                                      for n in stack.nodes))
+
+
+def actuator_priority(stack) -> int:
+    """The control chain's real-time priority (the highest in the stack): this process stands
+    in for the servo switch's driver, which has it on the boat (config/stack_boat*.yaml)."""
+    return max(n.realtime_priority for n in stack.nodes)
+
+
+def load_traces(trace_dir: Path, pids: dict[str, int]) -> dict[str, list]:
+    """Each node's trace (benchmarks/latency_trace), by node name; missing ones left out."""
+    traces = {}
+    for name, pid in pids.items():
+        path = trace_dir / f'{pid}.pickle'
+        if path.exists():
+            with path.open('rb') as trace:
+                traces[name] = pickle.load(trace)
+    return traces
+
+
+def report_latency(traces: dict[str, list], takes: list[tuple[int, int]],
+                   window: tuple[int, int], cores: str) -> None:
+    """Print (and report) sensor -> command latency at the actuator side, in parts."""
+    if SIM_NODE not in traces or not takes:
+        print(f'latency: not measured (traces of {sorted(traces)}, {len(takes)} commands taken)')
+        return
+    here = chain_latencies(traces, takes, window)
+    sim_takes = [(t, stamp) for kind, topic, stamp, t, _, _ in traces[SIM_NODE]
+                 if kind == 'take' and topic == '/tracks/cmd']
+    at_sim = chain_latencies(traces, sim_takes, window)
+    if not len(here.total_s):
+        print(f'latency: no sample led to a command (lost={here.lost})')
+        return
+    print(f'latency imu/data publish -> tracks/cmd taken at the actuator side, n='
+          f'{len(here.total_s)} lost={here.lost}   (issue 16: p50 <= 1 ms, p99 <= 5 ms, aim 2)')
+    for part, values in (('total', here.total_s), ('  sample delivery to the chain',
+                                                    here.sensor_delivery_s),
+                         ('  chain take -> command publish', here.in_chain_s),
+                         ('  command publish + delivery', here.command_delivery_s),
+                         ('taken by sim_node (busy stepping)', at_sim.total_s)):
+        p50, p90, p99 = np.percentile(values * 1e3, [50, 90, 99])
+        print(f'  {part:<36} p50 {p50:5.2f}  p90 {p90:5.2f}  p99 {p99:5.2f}  '
+              f'max {values.max() * 1e3:5.2f} ms')
+    p50, p99 = np.percentile(here.total_s * 1e3, [50, 99])
+    report(f'stack latency sensor->command p50{cores}', p50, 'ms', target=1.0)
+    report(f'stack latency sensor->command p99{cores}', p99, 'ms', target=5.0, aim=2.0)
+
+
+def priorities(stack) -> str:
+    """Which processes run under SCHED_FIFO (stack file's realtime_priority)."""
+    fifo = [f'{n.name} {n.realtime_priority}' for n in stack.nodes if n.realtime_priority]
+    return ('SCHED_FIFO: ' + ', '.join(fifo) + ' (and this probe as the actuator side)'
+            if fifo else 'all at normal priority')
 
 
 def pin_to_cores(pids: dict[str, int], cores: int) -> str:
@@ -109,10 +191,11 @@ def pin_to_cores(pids: dict[str, int], cores: int) -> str:
             f'computer): {", ".join(pinned)}; {SIM_NODE} not pinned')
 
 
-def label(stack_name: str, cores: int) -> str:
-    """The figure's suffix: which stack shape, how many cores (the main job's shape bare)."""
+def label(stack_name: str, cores: int, normal_priority: bool = False) -> str:
+    """The figure's suffix: which stack shape, how many cores, normal priority (the main
+    job's shape as its stack file says: bare)."""
     parts = ([] if stack_name == 'sim_composed' else [f'stack {stack_name}']) + (
-        [f'{cores} core(s)'] if cores else [])
+        [f'{cores} core(s)'] if cores else []) + (['normal priority'] if normal_priority else [])
     return ''.join(f', {p}' for p in parts)
 
 
@@ -126,6 +209,9 @@ def main() -> int:
                              "chain in one process, the main job's; sim = one process per "
                              'node) or a stack file; repeat to measure several in turn '
                              '(default: sim_composed, then sim: both shapes side by side)')
+    parser.add_argument('--normal-priority', action='store_true',
+                        help="run every process at normal priority, not at the stack file's "
+                             'realtime_priority (to see what the priority buys)')
     parser.add_argument('--cores', type=int, default=0,
                         help='pin the stack (not the simulator) to this many cores; 0 = free')
     args = parser.parse_args()
@@ -137,23 +223,26 @@ def main() -> int:
 def measure(stack_name: str, args: argparse.Namespace) -> int:
     """Run one stack, measure, print; 1 if a node died."""
     run_dir = Path(tempfile.mkdtemp(prefix='bench_stack_'))
+    trace_dir = run_dir / 'trace'
+    trace_dir.mkdir()
     stack = load_stack(stack_path(stack_name))
+    stack = with_priorities(stack, args.normal_priority)
     config, overlay = prepare_run(run_dir, default_config_path(), stack, load_mission(), 1.0)
-    runner = Runner(stack, [config, overlay], log_dir=run_dir / 'logs', echo=False)
+    env = {TRACE_ENV: str(trace_dir), 'PYTHONPATH': os.pathsep.join(
+        [str(TRACER_DIR)] + [p for p in [os.environ.get('PYTHONPATH')] if p])}
+    runner = Runner(stack, [config, overlay], log_dir=run_dir / 'logs', echo=False, env=env)
     runner.start()
     pinning = 'not pinned (all cores)'
-    probe = Probe(overlay)
+    probe = Probe(overlay, actuator_priority(stack))
     try:
         if args.cores:
             pinning = pin_to_cores(runner.pids(), args.cores)
         probe.spin(args.warmup)
         pids = runner.pids()
         cpu0 = {name: cpu_seconds(pid) for name, pid in pids.items()}
-        wall0 = time.monotonic()
-        probe.recording = True
+        wall0, window0 = time.monotonic(), time.monotonic_ns()
         probe.spin(args.duration)
-        probe.recording = False
-        wall = time.monotonic() - wall0
+        wall, window = time.monotonic() - wall0, (window0, time.monotonic_ns())
         cpu = {name: cpu_seconds(pid) - cpu0[name] for name, pid in pids.items()}
         dead = runner.poll()
     finally:
@@ -162,40 +251,21 @@ def measure(stack_name: str, args: argparse.Namespace) -> int:
     if dead is not None:
         print(f'node {dead.spec.name} died during the benchmark; logs in {run_dir}/logs')
         return 1
-    arrays = {k: np.array(v, dtype=float).reshape(-1, 2) for k, v in probe.records.items()}
     print(f'stack on the simulator (real-time factor 1, 100 Hz), {wall:.1f} s measured; '
           f'logs in {run_dir}/logs')
     shapes = [n.name + (' = ' + '+'.join(n.composes) if n.composes else '')
               for n in stack.nodes]
     print(f'stack {stack.name!r}, {len(stack.nodes)} processes ({", ".join(shapes)}); '
-          f'processes {pinning}')
-    print('messages received: ' + ', '.join(f'{k} {len(v)}' for k, v in arrays.items()))
-    if min(len(v) for v in arrays.values()) == 0:
-        print('latency: not measured (a topic of the chain is silent)')
-    else:
-        delivery = arrays['imu'][:, 0] - arrays['imu'][:, 1]
-        use_stamps = bool(0.0 <= np.median(delivery) < 1.0)
-        latencies, lost = pair_latencies(arrays['imu'], arrays['odom'], arrays['cmd'],
-                                         use_stamps)
-        source = 'stamp (wall clock)' if use_stamps else 'receive time here (sim-time stamps)'
-        if len(latencies):
-            p50, p99 = np.percentile(latencies * 1e3, [50, 99])
-            print(f'latency imu/data -> tracks|props/cmd (sensor time = {source}): '
-                  f'p50 {p50:.2f} ms  p99 {p99:.2f} ms  max {latencies.max() * 1e3:.2f} ms  '
-                  f'n={len(latencies)} lost={lost}   target p99 <= 10 ms '
-                  '(issue 16: p50 <= 1 ms, p99 <= 5 ms aiming at 2 ms)')
-            cores = label(stack.name, args.cores)
-            report(f'stack latency sensor->command p50{cores}', p50, 'ms', target=1.0)
-            report(f'stack latency sensor->command p99{cores}', p99, 'ms', target=5.0, aim=2.0)
-        else:
-            print(f'latency: no pairs (lost={lost})')
+          f'processes {pinning}; {priorities(stack)}')
+    report_latency(load_traces(trace_dir, pids), probe.takes, window,
+                   label(stack.name, args.cores, args.normal_priority))
     print('CPU share of one core:')
     for name, seconds in cpu.items():
         print(f'  {name:<24} {100.0 * seconds / wall:6.1f} %')
     without_sim = sum(s for n, s in cpu.items() if n != SIM_NODE)
     print(f'  {"stack without the sim":<24} {100.0 * without_sim / wall:6.1f} %'
           '   target <= 25 %, aim 15 %')
-    cores = label(stack.name, args.cores)
+    cores = label(stack.name, args.cores, args.normal_priority)
     report(f'stack CPU without the sim{cores}', 100.0 * without_sim / wall, '% of a core',
            target=25.0, aim=15.0)
     # the issue's 48 % baseline counted the control nodes only (EKF, controller, mission, mode

@@ -11,6 +11,11 @@ file (config/stack_sim.yaml, config/stack_boat.yaml) lists the nodes:
 
 ``args`` are ROS arguments (after the parameter files), ``cli_args`` the program's
 own (before ``--ros-args``), ``rename: true`` runs the node under ``name``.
+``realtime_priority: N`` (1-98) runs the process, all its threads, under the real-time
+policy SCHED_FIFO at priority N: the control chain and the devices at its two ends wake at
+once when a message arrives, even on a loaded computer (benchmarks/bench_stack.py; it needs
+root, CAP_SYS_NICE or an ``rtprio`` limit: without, the runner says so and the node runs at
+normal priority; the kernel's real-time throttling still leaves 5 % of each core to others).
 ``composes: [ekf_node, ...]`` (with ``executable: compose``) runs those nodes in one
 process with one executor (dukw_bringup.compose; config/stack_sim_composed.yaml). A stack
 with ``clock_node: sim_node`` runs every other node with ``use_sim_time:=true``
@@ -30,6 +35,7 @@ restarts nothing. This module imports no rclpy.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import ctypes
 import os
 import re
@@ -38,7 +44,7 @@ import subprocess
 import sys
 import threading
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import IO, Any, Mapping, Sequence
 
@@ -52,6 +58,8 @@ DISCOVERY_ENV = 'ROS_AUTOMATIC_DISCOVERY_RANGE'
 #: SROS2 enclaves of config/sros2/dukw_policy.xml: one per node, /dukw/<node name>
 ENCLAVE_ROOT = '/dukw'
 DISCOVERY_RANGES = ('LOCALHOST', 'SUBNET', 'OFF', 'SYSTEM_DEFAULT')
+#: highest realtime_priority of a stack file (99 stays free for the kernel's watchdogs)
+MAX_PRIORITY = 98
 
 
 @dataclass(frozen=True)
@@ -65,6 +73,7 @@ class NodeSpec:
     rename: bool = False            # run under ``name`` (-r __node:=name), for a second instance
     cli_args: tuple[str, ...] = ()  # the program's own arguments, before --ros-args
     composes: tuple[str, ...] = ()  # ROS nodes this process runs (compose); () = itself
+    realtime_priority: int = 0      # SCHED_FIFO priority of the process; 0 = normal
 
     @property
     def node_names(self) -> tuple[str, ...]:
@@ -88,6 +97,11 @@ class StackSpec:
     def node_names(self) -> list[str]:
         """Every ROS node of the stack (a composed process's nodes one by one)."""
         return [name for spec in self.nodes for name in spec.node_names]
+
+    def at_normal_priority(self) -> StackSpec:
+        """The same stack with no process under SCHED_FIFO (faster than real time the wall
+        clock latency means nothing, and a chain working flat out would hog a core)."""
+        return replace(self, nodes=tuple(replace(n, realtime_priority=0) for n in self.nodes))
 
     def node(self, name: str) -> NodeSpec:
         """The node called ``name``; KeyError if there is none."""
@@ -122,7 +136,8 @@ def parse_stack(doc: Any, source: str = 'stack') -> StackSpec:
             lists[key] = tuple(str(a) for a in value)
         nodes.append(NodeSpec(raw['name'], raw['package'], raw['executable'], lists['args'],
                               bool(raw.get('rename', False)), lists['cli_args'],
-                              _composes(raw, f'{source}: stack.nodes[{i}]')))
+                              _composes(raw, f'{source}: stack.nodes[{i}]'),
+                              _priority(raw, f'{source}: stack.nodes[{i}]')))
     names = [n.name for n in nodes]
     if len(set(names)) != len(names):
         raise ConfigError(f'{source}: node names must be unique, got {names}')
@@ -149,6 +164,15 @@ def _composes(raw: Mapping, where: str) -> tuple[str, ...]:
     if value and raw.get('rename'):
         raise ConfigError(f'{where}: rename would rename every composed node; drop it')
     return tuple(value)
+
+
+def _priority(raw: Mapping, where: str) -> int:
+    """A process's ``realtime_priority`` (SCHED_FIFO 1-98; 0 or absent: normal), checked."""
+    value = raw.get('realtime_priority', 0)
+    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= MAX_PRIORITY:
+        raise ConfigError(f'{where}.realtime_priority must be an integer 0..{MAX_PRIORITY} '
+                          f'(0 = normal), got {value!r}')
+    return value
 
 
 def load_stack(path: str | Path) -> StackSpec:
@@ -203,6 +227,32 @@ def _die_with_parent() -> None:
     """In the child before exec: get SIGTERM if the runner itself dies (Linux)."""
     if _PRCTL is not None:
         _PRCTL(_PR_SET_PDEATHSIG, int(signal.SIGTERM))
+
+
+def _child_setup(priority: int):
+    """What the child runs before exec: die with the runner; take its real-time priority
+    (inherited by every thread it starts; refused without the right: checked afterwards)."""
+    def setup() -> None:
+        _die_with_parent()
+        if priority:
+            with contextlib.suppress(OSError):
+                os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    return setup
+
+
+def realtime_refusal(pid: int, priority: int) -> str:
+    """'' when process ``pid`` runs at SCHED_FIFO ``priority`` (or none was asked), else why
+    not."""
+    if not priority:
+        return ''
+    try:
+        if (os.sched_getscheduler(pid) == os.SCHED_FIFO
+                and os.sched_getparam(pid).sched_priority == priority):
+            return ''
+    except OSError as exc:
+        return f'cannot read its scheduling: {exc}'
+    return (f'realtime_priority {priority} refused (needs root, CAP_SYS_NICE or an rtprio '
+            'limit): it runs at normal priority, its latency suffers when the computer is busy')
 
 
 @dataclass
@@ -260,13 +310,17 @@ class Runner:
         log = open(self.log_dir / f'{spec.name}.log', 'w') if self.log_dir else None
         proc = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                                 stderr=subprocess.STDOUT, text=True, bufsize=1, env=self.env,
-                                start_new_session=True, preexec_fn=_die_with_parent)
+                                start_new_session=True,
+                                preexec_fn=_child_setup(spec.realtime_priority))
         node = NodeProc(spec, proc, log)
         node.reader = threading.Thread(target=self._pump, args=(node,), daemon=True,
                                        name=f'bringup-{spec.name}')
         node.reader.start()
         self.procs.append(node)
         self.say(f'started {spec.name} (pid {proc.pid}): {" ".join(command)}')
+        refusal = realtime_refusal(proc.pid, spec.realtime_priority)
+        if refusal:
+            self.say(f'WARNING: {spec.name}: {refusal}')
 
     def _pump(self, node: NodeProc) -> None:
         if node.proc.stdout is None:

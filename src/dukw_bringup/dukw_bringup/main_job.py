@@ -157,6 +157,8 @@ def run(args: argparse.Namespace, stop: threading.Event) -> int:
         if args.waypoints:
             mission = mission.with_waypoints(args.waypoints)
         stack = load_stack(stack_path(args.stack))
+        if args.rtf != 1.0:          # real-time priority only at real time (bringup)
+            stack = stack.at_normal_priority()
         run_dir = make_run_dir(args.out or default_run_dir(Path.cwd()))
         stack = with_recorder(stack, run_dir / BAG_DIR)
         shore_key = None

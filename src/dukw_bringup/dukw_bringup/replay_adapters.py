@@ -72,8 +72,9 @@ def control_row(out: ControlOutput | None) -> dict[str, float] | None:
     """A control step's commands as named numbers (None: no step)."""
     if out is None:
         return None
-    return {**_side_row('tracks', out.tracks.port, out.tracks.stbd),
-            **_side_row('props', out.props.port, out.props.stbd)}
+    tracks, props = out.tracks, out.props
+    return {'tracks.port_pct': float(tracks.port), 'tracks.stbd_pct': float(tracks.stbd),
+            'props.port_pct': float(props.port), 'props.stbd_pct': float(props.stbd)}
 
 
 class ModeManagerAdapter(CoreAdapter):
@@ -89,20 +90,24 @@ class ModeManagerAdapter(CoreAdapter):
             node_params('mode_manager_node', config_path))
         self.rate_hz = self.runner.rate_hz
         self.core = self.runner.core
+        self._handlers = self._handle()
 
     def feed(self, topic, t_s, msg):
-        r = self.runner
-        if topic == 'water/contact':
-            r.on_water_contact(msg.fore_wet, msg.aft_wet, t_s)
-        elif topic == 'depth':
-            r.on_depth(msg.valid, msg.depth_m, t_s)
-        elif topic == 'traction':
-            r.on_traction(msg.weight_on_tracks_fraction, t_s)
-        elif topic == 'tracks/status':
-            r.on_track_status(msg.connected, msg.port.force_n, msg.stbd.force_n, t_s)
-        elif topic == 'imu/data':
-            r.on_imu(control_convert.stamp_or(msg, t_s), t_s)
+        handler = self._handlers.get(topic)
+        if handler is not None:
+            handler(msg, t_s)
         return None
+
+    def _handle(self) -> dict[str, Callable[[Any, float], Any]]:
+        """Per input topic: message -> runner call (a lookup, not a chain of ifs)."""
+        r = self.runner
+        return {
+            'water/contact': lambda msg, t_s: r.on_water_contact(msg.fore_wet, msg.aft_wet, t_s),
+            'depth': lambda msg, t_s: r.on_depth(msg.valid, msg.depth_m, t_s),
+            'traction': lambda msg, t_s: r.on_traction(msg.weight_on_tracks_fraction, t_s),
+            'tracks/status': lambda msg, t_s: r.on_track_status(
+                msg.connected, msg.port.force_n, msg.stbd.force_n, t_s),
+            'imu/data': lambda msg, t_s: r.on_imu(control_convert.stamp_or(msg, t_s), t_s)}
 
     def tick(self, t_s):
         """Every tick's decision is compared (the node publishes only some of them)."""
@@ -128,33 +133,50 @@ class DriveControllerAdapter(CoreAdapter):
             node_params('drive_controller_node', config_path))
         self.rate_hz = self.runner.rate_hz
         self.core = self.runner.core
+        self._handlers = self._handle()
 
     def feed(self, topic, t_s, msg):
+        handler = self._handlers.get(topic)
+        if handler is None:
+            return None
+        out = handler[0](msg, t_s)
+        return out if handler[1] else None
+
+    def _handle(self) -> dict[str, tuple[Callable[[Any, float], Any], bool]]:
+        """Per input topic: (message -> runner call, whether that call steps and its result
+        is an output row) -- a lookup, not a chain of ifs."""
         r, c = self.runner, control_convert
-        if topic == 'cmd_vel':          # Twist or TwistStamped, whichever the bag holds
+
+        def cmd_vel(msg, t_s):          # Twist or TwistStamped, whichever the bag holds
             speed_mps, yaw_rate_rps, stamp_s = read_cmd_vel(msg)
             r.on_cmd_vel(speed_mps, yaw_rate_rps, t_s, stamp_s)
-        elif topic == 'authority':
-            return control_row(r.on_authority(*c.authority_usable(msg), t_s))
-        elif topic == 'drive_mode':
-            r.on_mode(c.decision_from_msg(msg), t_s)
-        elif topic == 'odometry/filtered':
-            return control_row(r.on_odometry(
-                msg.twist.twist.linear.x, msg.twist.twist.angular.z,
-                c.pitch_from_quaternion(msg.pose.pose.orientation), t_s))
-        elif topic == 'imu/data':
-            r.on_imu(c.stamp_or(msg, t_s), t_s)
-        elif topic == 'traction':
-            r.on_traction(msg.port_slip, msg.stbd_slip, t_s)
-        elif topic == 'tracks/status':
-            r.on_track_status(msg.connected, msg.port.current_a, msg.stbd.current_a, t_s)
-        return None
+
+        def odometry(msg, t_s):
+            twist = msg.twist.twist
+            return control_row(r.on_odometry(twist.linear.x, twist.angular.z,
+                                             c.pitch_from_quaternion(msg.pose.pose.orientation),
+                                             t_s))
+        return {
+            'cmd_vel': (cmd_vel, False),
+            'authority': (lambda msg, t_s: control_row(r.on_authority(
+                *c.authority_usable(msg), t_s)), True),
+            'drive_mode': (lambda msg, t_s: r.on_mode(c.decision_from_msg(msg), t_s), False),
+            'odometry/filtered': (odometry, True),
+            'imu/data': (lambda msg, t_s: r.on_imu(c.stamp_or(msg, t_s), t_s), False),
+            'traction': (lambda msg, t_s: r.on_traction(msg.port_slip, msg.stbd_slip, t_s),
+                         False),
+            'tracks/status': (lambda msg, t_s: r.on_track_status(
+                msg.connected, msg.port.current_a, msg.stbd.current_a, t_s), False)}
 
     def tick(self, t_s):
         return control_row(self.runner.tick(t_s))
 
+    #: recorded output topic -> its row names (made once, not per message)
+    _ROW_NAMES = {topic: tuple(_side_row(topic.split('/')[0], 0.0, 0.0)) for topic in outputs}
+
     def recorded(self, topic, msg):
-        return _side_row(topic.split('/')[0], msg.port_pct, msg.stbd_pct)
+        port_name, stbd_name = self._ROW_NAMES[topic]
+        return {port_name: float(msg.port_pct), stbd_name: float(msg.stbd_pct)}
 
 
 class EkfAdapter(CoreAdapter):

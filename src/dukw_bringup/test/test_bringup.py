@@ -2,6 +2,7 @@
 import os
 import py_compile
 import re
+import resource
 import signal
 import subprocess
 import sys
@@ -102,10 +103,49 @@ def test_both_stacks_keep_the_ros_graph_on_the_vehicle_unless_told_otherwise():
     ({'stack': {'nodes': [{'name': 'ekf_node', 'package': 'p', 'executable': 'e'},
                           {'name': 'c', 'package': 'p', 'executable': 'e',
                            'composes': ['ekf_node']}]}}, 'runs twice'),
+    *[({'stack': {'nodes': [{'name': 'a', 'package': 'p', 'executable': 'e',
+                             'realtime_priority': bad}]}}, 'realtime_priority')
+      for bad in (99, -1, 'high', True, 20.0)],
 ])
 def test_bad_stack_file_is_refused(doc, message):
     with pytest.raises(ConfigError, match=message):
         parse_stack(doc)
+
+
+def test_the_chain_and_the_boat_devices_at_its_ends_run_under_sched_fifo():
+    for name in ('sim', 'sim_composed', 'boat', 'boat_composed'):
+        stack = load_stack(stack_path(name))
+        fifo = {n.name for n in stack.nodes if n.realtime_priority}
+        chain = ({'control_chain'} if 'composed' in name
+                 else {'ekf_node', 'mode_manager_node', 'drive_controller_node'})
+        devices = set() if name.startswith('sim') else {'imu_gps_node', 'servo_switch_node'}
+        assert fifo == chain | devices
+        priority = {n.name: n.realtime_priority for n in stack.nodes}
+        assert all(priority[d] < priority[c] for d in devices for c in chain)
+        normal = stack.at_normal_priority()     # (main_job faster than real time)
+        assert [n.name for n in normal.nodes] == [n.name for n in stack.nodes]
+        assert not any(n.realtime_priority for n in normal.nodes)
+        # not the simulator: at real_time_factor 0 it steps flat out, a real-time hog
+
+
+def test_a_process_gets_its_realtime_priority_or_the_runner_says_why_not():
+    from dukw_bringup.bringup import _child_setup, realtime_refusal
+    allowed = os.geteuid() == 0 or resource.getrlimit(resource.RLIMIT_RTPRIO)[0] >= 10
+    procs = [subprocess.Popen(['sleep', '10'], preexec_fn=_child_setup(p)) for p in (10, 0)]
+    try:
+        fifo, normal = procs
+        assert realtime_refusal(normal.pid, 0) == ''
+        assert 'refused' in realtime_refusal(normal.pid, 10)      # asked, not granted
+        if allowed:
+            assert os.sched_getscheduler(fifo.pid) == os.SCHED_FIFO
+            assert realtime_refusal(fifo.pid, 10) == ''
+            assert 'refused' in realtime_refusal(fifo.pid, 11)
+        else:
+            assert 'CAP_SYS_NICE' in realtime_refusal(fifo.pid, 10)
+    finally:
+        for proc in procs:
+            proc.kill()
+            proc.wait()
 
 
 def test_launch_file_compiles(tmp_path):

@@ -146,3 +146,38 @@ def test_compose_refuses_an_unknown_node():
                           capture_output=True, text=True, timeout=60)
     assert done.returncode == 2
     assert 'usage: compose' in done.stderr
+
+
+def test_the_command_goes_out_before_the_observers_odometry_in_the_imu_callback():
+    """In the composed process the controller steps on the estimate and tracks/cmd is
+    published before ekf_node builds and publishes odometry/filtered for the observers."""
+    import rclpy
+
+    from dukw_bringup import compose
+    from dukw_common.config import default_config_path
+    rclpy.init(args=['--ros-args', '--params-file', str(default_config_path()),
+                     '--log-level', 'error'])
+    nodes = compose.build(CHAIN)
+    try:
+        ekf, controller = nodes[0], nodes[-1]
+        order = []
+        for name, publisher in (('odometry/filtered', ekf.odom_pub),
+                                ('tracks/cmd', controller.commands.tracks)):
+            publisher.publish = (lambda msg, n=name, p=publisher.publish:
+                                 (order.append(n), p(msg)))
+        on_imu = next(sub.callback for node in nodes for sub in node.subscriptions
+                      if sub.topic_name == '/imu/data')
+        for _ in range(20):
+            imu = Imu()
+            imu.header.stamp = ekf.get_clock().now().to_msg()
+            imu.orientation.w = 1.0
+            imu.linear_acceleration.z = GRAVITY_MPS2
+            on_imu(imu)
+            time.sleep(0.01)
+        assert order.count('odometry/filtered') >= 10
+        pairs = list(zip(order[::2], order[1::2], strict=True))
+        assert set(pairs) == {('tracks/cmd', 'odometry/filtered')}
+    finally:
+        for node in reversed(nodes):
+            node.destroy_node()
+        rclpy.try_shutdown()

@@ -1,39 +1,60 @@
-"""Latency pairing and CPU time of the stack benchmark."""
+"""Latency pairing (from the processes' traces) and CPU time of the stack benchmark."""
 import math
 import os
 
-import numpy as np
 import pytest
 
-from dukw_bringup.stack_metrics import cpu_seconds, pair_latencies
+from dukw_bringup.stack_metrics import chain_latencies, cpu_seconds
 
 
-def test_each_sensor_message_pairs_with_the_command_after_its_estimate():
-    # imu at 0.000 / 0.010 s (stamps = wall), odometry stamped like the imu 2 ms later,
-    # commands on a timer at 0.005, 0.015, 0.025
-    sensor = np.array([[0.0005, 0.000], [0.0105, 0.010]])
-    estimate = np.array([[0.002, 0.000], [0.012, 0.010]])
-    command = np.array([[0.005, 0.0], [0.015, 0.0], [0.025, 0.0]])
-    latencies, lost = pair_latencies(sensor, estimate, command, use_stamps=True)
-    assert latencies == pytest.approx([0.005, 0.005]) and lost == 0
-    latencies, _ = pair_latencies(sensor, estimate, command, use_stamps=False)
-    assert latencies == pytest.approx([0.0045, 0.0045])
+MS = 1_000_000
+IMU, ODOM, CMD = '/imu/data', '/odometry/filtered', '/tracks/cmd'
 
 
-def test_a_command_before_the_estimate_does_not_count():
-    sensor = np.array([[0.0, 0.0]])
-    estimate = np.array([[0.006, 0.0]])
-    command = np.array([[0.004, 0.0], [0.009, 0.0]])
-    latencies, _ = pair_latencies(sensor, estimate, command, use_stamps=True)
-    assert latencies == pytest.approx([0.009])
+def sim_trace(stamps_ms):
+    """The simulator publishes imu/data stamped S at wall S (ms, here as ns)."""
+    return [('pub', IMU, s * MS, s * MS, s * MS + MS // 10, None) for s in stamps_ms]
 
 
-def test_no_command_in_the_window_is_lost():
-    sensor = np.array([[0.0, 0.0]])
-    estimate = np.array([[0.001, 0.0]])
-    latencies, lost = pair_latencies(sensor, estimate, np.array([[0.5, 0.0]]), use_stamps=True)
-    assert len(latencies) == 0 and lost == 1
-    assert pair_latencies(sensor, estimate, np.empty((0, 2)), use_stamps=True)[1] == 1
+def test_a_command_traces_back_through_every_hop_to_its_sample():
+    # separate processes: imu 0 -> ekf takes at 0.3, odometry (stamp 0) at 0.5 -> controller
+    # takes at 0.8, command (clock stamp 7) at 0.9 -> actuator at 1.2 ms
+    traces = {'sim': sim_trace([0]),
+              'ekf': [('take', IMU, 0, 3 * MS // 10, MS, None),
+                      ('pub', ODOM, 0, MS // 2, 6 * MS // 10, (IMU, 0))],
+              'ctrl': [('take', ODOM, 0, 8 * MS // 10, MS, None),
+                       ('pub', CMD, 7, 9 * MS // 10, MS, (ODOM, 0))]}
+    result = chain_latencies(traces, [(12 * MS // 10, 7)], (0, 10 * MS))
+    assert result.total_s == pytest.approx([0.0012])
+    assert result.sensor_delivery_s == pytest.approx([0.0003])
+    assert result.in_chain_s == pytest.approx([0.0006])
+    assert result.command_delivery_s == pytest.approx([0.0003]) and result.lost == 0
+
+
+def test_a_timer_command_or_one_never_taken_does_not_count():
+    # composed: the command of imu 0 goes out in its callback; a timer command (no cause) at
+    # 2 ms; imu 10's command is never taken: lost. An actuator take of another stamp is
+    # skipped (a command the trace does not know, e.g. before the actuator matched).
+    traces = {'sim': sim_trace([0, 10]),
+              'chain': [('take', IMU, 0, MS // 5, MS, None),
+                        ('pub', CMD, 5, MS // 2, MS // 2, (IMU, 0)),
+                        ('pub', CMD, 6, 2 * MS, 2 * MS, None),
+                        ('take', IMU, 10 * MS, 10 * MS, 11 * MS, None),
+                        ('pub', CMD, 8, 11 * MS, 11 * MS, (IMU, 10 * MS))]}
+    takes = [(MS // 4, 99), (MS, 5), (3 * MS, 6)]
+    result = chain_latencies(traces, takes, (0, 20 * MS))
+    assert result.total_s == pytest.approx([0.001]) and result.lost == 1
+
+
+def test_a_sample_outside_the_window_or_its_command_too_late_is_not_counted():
+    traces = {'sim': sim_trace([0, 10]),
+              'chain': [('take', IMU, 0, 0, MS, None), ('pub', CMD, 1, MS, MS, (IMU, 0)),
+                        ('take', IMU, 10 * MS, 10 * MS, 11 * MS, None),
+                        ('pub', CMD, 2, 11 * MS, 11 * MS, (IMU, 10 * MS))]}
+    takes = [(2 * MS, 1), (500 * MS, 2)]
+    result = chain_latencies(traces, takes, (5 * MS, 20 * MS))
+    assert len(result.total_s) == 0 and result.lost == 1
+    assert len(chain_latencies(traces, takes, (0, 5 * MS)).total_s) == 1
 
 
 def test_cpu_seconds_of_this_process_and_of_a_missing_one():

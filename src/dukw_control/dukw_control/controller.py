@@ -224,6 +224,8 @@ class DriveController:
         self._last_step_s: float | None = None
         self._last_mix_flags = (False, False)   # (speed, yaw) saturated last cycle
         self.output = ControlOutput(neutral_reason='starting')
+        self._hand_gains = PiGains(settings.speed_kp, settings.speed_ki, settings.yaw_kp,
+                                   settings.yaw_ki)   # made once, not per step
 
     # --- inputs -----------------------------------------------------------------------
     def on_cmd_vel(self, speed_mps: float, yaw_rate_rps: float, now_s: float,
@@ -404,7 +406,8 @@ class DriveController:
         elif closed:
             self._use_gains(s.water_gains if prop_w > track_w else None)
             main = self._last_mix_flags
-            derated = min(c.scale for c in self.current.values()) < 1.0 and track_w > 0
+            derated = min(self.current['port'].scale, self.current['stbd'].scale) < 1.0 \
+                and track_w > 0
             speed_cmd += self.speed_pi.update(speed_sp - i.odom[0], dt,
                                               main[0] or derated, main[0] or derated)
             yaw_cmd += self.yaw_pi.update(yaw_sp - i.odom[1], dt, main[1], main[1])
@@ -427,8 +430,7 @@ class DriveController:
 
     def _use_gains(self, gains: PiGains | None) -> None:
         """PI gains of the medium that carries the vehicle (None: the land / hand ones)."""
-        s = self.s
-        g = gains or PiGains(s.speed_kp, s.speed_ki, s.yaw_kp, s.yaw_ki)
+        g = gains or self._hand_gains
         self.speed_pi.kp, self.speed_pi.ki = g.speed_kp, g.speed_ki
         self.yaw_pi.kp, self.yaw_pi.ki = g.yaw_kp, g.yaw_ki
 

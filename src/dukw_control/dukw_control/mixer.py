@@ -19,7 +19,10 @@ class SidePair:
     stbd: float = 0.0
 
     def scaled(self, factor: float) -> 'SidePair':
-        """Both sides times ``factor``."""
+        """Both sides times ``factor`` (itself for 1.0: a float times 1.0 is itself, bit for
+        bit; the controller scales by 1.0 on most cycles)."""
+        if factor == 1.0 and type(self.port) is float and type(self.stbd) is float:
+            return self
         return SidePair(self.port * factor, self.stbd * factor)
 
     def is_neutral(self) -> bool:

@@ -88,11 +88,11 @@ class EkfNode(Node):
     def _publish(self, estimate: Estimate | None) -> None:
         if estimate is None:
             return
+        for listen in self.estimate_listeners:   # in-process consumers (commands) first,
+            listen(estimate)                     # before the observers' messages
         stamp = s_to_stamp(estimate.t_s)
         odom = conv.odometry_msg(estimate.odometry, stamp, 'odom', 'base_link', self._odom_msg)
         self.odom_pub.publish(odom)
-        for listen in self.estimate_listeners:   # in-process consumers (commands) first
-            listen(estimate)
         if self.tf_pub is not None and estimate.tf_due:
             self.tf_pub.publish(odometry_tf(odom))
         if estimate.traction_due:

@@ -71,6 +71,7 @@ class Estimator:
     def reset(self) -> None:
         """Forget everything but the counters: back to the initial covariance."""
         self.motion_filter.reset()
+        self.status_ground_mps: tuple[float, float] | None = None
         self.contact.reset()
         self.surface.reset()
         self.online_soil.reset(self.online_soil.prior)
@@ -183,6 +184,9 @@ class Estimator:
             return rejected
         motion = self.motion_filter
         motion.tracks = s
+        # the ground under the tracks when their speeds were measured: the slip compares
+        # both at one time (a belt spinning up at 0.6 m/s^2 gains 0.03 m/s between statuses)
+        self.status_ground_mps = ground_speeds(self.ekf.x, self.vehicle.body.hull_separation_m)
         self.contact.smooth_track_forces(s)
         if not motion.fresh('gps_vel', s.t_s) and self.contact.fraction > GROUNDED_FRACTION:
             motion.track_odometry(s)
@@ -259,14 +263,13 @@ class Estimator:
                                 afloat, float(x[Idx.ETA]))
 
     def _slips_and_forces(self, weight_n: float) -> tuple[list[float], list[float]]:
-        """Slip per track and the Wong force of ``weight_n`` at it (NaN before a status)."""
+        """Slip per track and the Wong force of ``weight_n`` at it (NaN before a status), at
+        the last status's time: its belt speeds against the ground speeds then."""
         slips = [math.nan, math.nan]
         predicted = [math.nan, math.nan]
-        tracks = self.motion_filter.tracks
-        if tracks is None:
+        tracks, ground = self.motion_filter.tracks, self.status_ground_mps
+        if tracks is None or ground is None:
             return slips, predicted
-        body = self.vehicle.body
-        ground = ground_speeds(self.ekf.x, body.hull_separation_m)
         stopped = self.settings.slip_stopped_track_mps
         speeds = [0.0 if abs(v) < stopped else v
                   for v in (tracks.port.speed_mps, tracks.stbd.speed_mps)]

@@ -147,6 +147,11 @@ class EkfSettings:
     force_update_min_track_speed_mps: float = _f(
         'force_update.min_track_speed_mps', 'both tracks turning at least this fast (the slip '
         'of a nearly stopped track is the ground speed error over its speed)', 0, 10)
+    force_update_held_min_ground_mps: float = _f(
+        'force_update.held_min_ground_mps', 'both tracks held (slower than '
+        'slip.stopped_track_mps) while the ground under both moves at least this fast: their '
+        'slip is -1 and the braking force the full shear strength of the soil, which tells the '
+        'weight (0: held tracks never update)', 0, 10)
     force_update_sigma_n: float = _f('force_update.sigma_n', 'per track: current noise, '
                                      'unmodelled friction and paddle thrust (0: off)', 0, 1e4)
     force_update_period_s: float = _f('force_update.period_s', 'at most this often (the '

@@ -131,7 +131,9 @@ class SurfaceObserver:
             return
         speeds = (s.port.speed_mps, s.stbd.speed_mps)
         ground = ground_speeds(ekf.x, self.vehicle.body.hull_separation_m)
-        if not self._slipping(speeds, ground):
+        if self._held_sliding(speeds, ground):
+            speeds = (0.0, 0.0)          # held belts: the encoder's noise is no speed
+        elif not self._slipping(speeds, ground):
             return
         measured = [self.contact.measured_soil_force_n(s, k) for k in range(2)]
         if not all(math.isfinite(m) for m in measured):
@@ -146,6 +148,15 @@ class SurfaceObserver:
         return not (st.force_update_sigma_n <= 0.0
                     or t_s - self.grounded_since_s < st.force_update_settle_s
                     or t_s - self.force_update_t_s < st.force_update_period_s)
+
+    def _held_sliding(self, speeds: tuple[float, float], ground: tuple[float, float]) -> bool:
+        """Both belts held while the ground under both moves: each slips at -1, where the
+        Wong force is the soil's full shear strength whatever the speeds' errors (a vehicle
+        grounding in the surf with its tracks off, carried by the waves)."""
+        st = self.settings
+        least = st.force_update_held_min_ground_mps
+        return least > 0.0 and all(abs(speeds[k]) < st.slip_stopped_track_mps
+                                   and abs(ground[k]) >= least for k in range(2))
 
     def _slipping(self, speeds: tuple[float, float], ground: tuple[float, float]) -> bool:
         """Both tracks turn fast enough and slip enough for the force to tell the weight."""

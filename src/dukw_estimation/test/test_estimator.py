@@ -129,6 +129,29 @@ def test_a_stopped_track_read_slightly_reversed_slips_as_a_stopped_one():
     assert est.traction().port_slip == 1.0
 
 
+def test_the_slip_of_a_belt_spinning_up_compares_speeds_of_one_time():
+    """Belt and vehicle accelerate together at 0.6 m/s^2 without slipping; the status comes
+    every 0.05 s. Between statuses the filter's ground speed runs 0.03 m/s ahead of the last
+    belt reading: the slip is taken at the status's time (else -0.1 at 0.3 m/s)."""
+    est = make()
+    rng = np.random.default_rng(3)
+    x, u, accel = -20.0, 0.0, 0.6
+    worst = 0.0
+    for k in range(1, 151):
+        t = k * 0.01
+        u += accel * 0.01
+        x += u * 0.01
+        est.add_imu(imu(t, 0.0, 0.0, accel + rng.normal(0, 0.01)))
+        if k % 10 == 0:
+            est.add_gps_fix(fix(t, x, 0.0))
+            est.add_gps_velocity(GpsVelocity(t, u, 0.0))
+        if k % 5 == 0:
+            est.add_tracks(tracks(t, u, u))
+        if k % 5 == 4 and 0.2 < u < 0.6 and t > 0.5:
+            worst = max(worst, abs(est.traction().port_slip))
+    assert 0.0 < worst < 0.04
+
+
 def test_on_dry_land_all_weight_on_tracks_and_force_prediction_matches_the_model():
     est = make()
     Drive(est).run(10.0)
@@ -286,16 +309,17 @@ def test_lying_still_in_a_trough_is_on_the_sand_though_the_mean_surface_would_fl
     assert out.weight_on_tracks_fraction > 0.05
 
 
-def _surf_run(est, true_surface_m, slip_, seconds=5.0, x0=5.0, track_mps=0.5):
-    """Crawl seaward on the slope with both tracks slipping by slip_, under a surface
-    true_surface_m off the mean; the track forces are the Wong forces of the true weight
-    (with the saturated sand's pore suction where the true surface covers the sand)."""
+def _surf_run(est, true_surface_m, slip_, seconds=5.0, x0=5.0, track_mps=0.5, ground_mps=None):
+    """Crawl seaward on the slope with both tracks slipping by slip_ (or held belts with the
+    ground at ``ground_mps``), under a surface true_surface_m off the mean; the track forces
+    are the Wong forces of the true weight (with the saturated sand's pore suction where the
+    true surface covers the sand)."""
     from dukw_model import buoyancy
     slope = VEHICLE.site.beach_slope_rad
     body, drive = VEHICLE.body, VEHICLE.drivetrain
     section = buoyancy.HullSection.of_body(body)
     soil = soil_params(PARAMS)
-    u = track_mps * (1.0 - slip_)
+    u = track_mps * (1.0 - slip_) if ground_mps is None else ground_mps
     x, t, fraction = x0, 0.0, math.nan
     for k in range(int(round(seconds / 0.01))):
         t += 0.01
@@ -321,7 +345,7 @@ def _surf_run(est, true_surface_m, slip_, seconds=5.0, x0=5.0, track_mps=0.5):
                                             VEHICLE.saturated_sand, saturation)
             sides = []
             for port in (True, False):    # the motors also turn the drivetrain
-                force = soil_n + drive.track_friction_n(port)
+                force = soil_n + (drive.track_friction_n(port) if track_mps else 0.0)
                 sides.append(MotorSide(30.0, force / drive.track_force_gain_n_per_a,
                                        track_mps, force))
             est.add_tracks(DriveStatus(t, *sides))
@@ -339,6 +363,44 @@ def test_slipping_track_forces_tell_the_weight_the_surface_leaves_on_the_tracks(
     off = abs(deaf.traction().weight_on_tracks_fraction - truth)
     assert off > 0.1                                   # the mean surface alone is well off
     assert abs(told.traction().weight_on_tracks_fraction - truth) < 0.4 * off
+
+
+def test_held_tracks_of_a_vehicle_carried_over_the_sand_tell_the_weight():
+    """Grounded in the surf with the tracks off (the mode still WATER), the waves carry the
+    vehicle over the sand at 0.2 m/s: the held belts slip at -1 and brake with the soil's
+    full strength at the true weight, which pulls the estimate towards it; a vehicle the
+    filter sees still (the ground slower than force_update.held_min_ground_mps) gives its
+    held belts' force no say."""
+    known = {'soil_online_enabled': False}
+    runs = {}
+    for name, changes, ground in (('told', {}, -0.2), ('deaf', {'force_update_sigma_n': 0.0},
+                                                       -0.2),
+                                  ('still', {}, -0.05)):
+        est = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, **known, **changes)
+        truth = _surf_run(est, -0.06, 0.0, track_mps=0.0, ground_mps=ground)
+        runs[name] = (est, truth)
+    (told, truth), (deaf, _) = runs['told'], runs['deaf']
+    off = abs(deaf.traction().weight_on_tracks_fraction - truth)
+    assert off > 0.1
+    assert abs(told.traction().weight_on_tracks_fraction - truth) < 0.4 * off
+    assert told.surface.force_update_t_s > 4.0
+    assert runs['still'][0].surface.force_update_t_s == -math.inf
+
+
+def test_an_unlearnt_soil_widens_the_track_force_noise():
+    """force_update.max_soil_spread above the prior's spread never waits, but the soil's
+    spread (the prior's, no dry sand yet) widens each update's noise: the forces move the
+    surface less than with the configured soil trusted, and still some."""
+    fractions = {}
+    for name, changes in (('trusted', {'force_update_max_soil_spread': 0.0}),
+                          ('widened', {'force_update_max_soil_spread': 10.0}),
+                          ('deaf', {'force_update_sigma_n': 0.0})):
+        est = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, **changes)
+        truth = _surf_run(est, -0.06, 0.4, seconds=1.0)
+        fractions[name] = est.traction().weight_on_tracks_fraction
+    assert fractions['deaf'] < fractions['widened'] - 0.01
+    assert fractions['widened'] < fractions['trusted'] - 0.01
+    assert fractions['trusted'] < truth + 0.05
 
 
 def test_track_forces_wait_until_the_sites_soil_is_learnt():

@@ -84,11 +84,13 @@ def test_refuses_a_bag_whose_weight_never_changes(tmp_path, capsys):
 
 def test_recovers_the_simulated_beach_from_a_recorded_surf_run(capsys):
     """The golden sea-to-land bag (simulator on the beach_72 soil, the EKF's traction as
-    recorded, scripts/make_golden.sh): phi and c within the fit's own uncertainty of the
-    truth. The sand there is saturated: its strength also grows with the slip velocity (the
-    shared saturated_sand.* pore suction, issue 13), which this rate-independent fit (the
-    paper's) reads as a faster shear development: k comes out below the truth (2.2 +- 1.0
-    cm against 5.3 cm) and the residual is larger (57 N; 25 N before the suction)."""
+    recorded, scripts/make_golden.sh): c, phi and k within three of the fit's own sigmas
+    of the truth. The sand there is saturated: its strength also grows with the slip
+    velocity (the shared saturated_sand.* pore suction, issue 13), which this
+    rate-independent fit (the paper's) cannot follow: phi 14.6 +- 2.9 deg against 9.9 and
+    k 7.5 +- 1.5 cm against 5.3 (issue 18's bag: the tracks start 0.5 s earlier, in the
+    surf, and the slip pairs with the force of its status; before: 9.7 deg, k 2.2 cm below
+    the truth, residual 57 N)."""
     bag = Path(__file__).resolve().parents[3] / 'tests' / 'golden' / 'sea_to_land'
     assert fit_terrain.main([str(bag)]) == 0
     assert 'residual rms' in capsys.readouterr().out
@@ -96,9 +98,9 @@ def test_recovers_the_simulated_beach_from_a_recorded_surf_run(capsys):
                                BODY.track_contact_length_m, initial=VEHICLE.soil)
     truth = VEHICLE.soil                  # the simulator's wet beach
     assert abs(fit.soil.friction_angle_rad - truth.friction_angle_rad) < 3 * fit.sigma[1]
-    assert fit.soil.shear_modulus_m < truth.shear_modulus_m
+    assert abs(fit.soil.shear_modulus_m - truth.shear_modulus_m) < 3 * fit.sigma[2]
     assert abs(fit.soil.cohesion_pa - truth.cohesion_pa) < 3 * fit.sigma[0]
-    assert fit.residual_rms_n < 70.0
+    assert fit.residual_rms_n < 50.0
     # all samples, the stopped tracks' clipped slips and the gripping ones included: off
     everything = fit_terrain.fit_soil(fit_terrain.read_samples(bag), AREA,
                                       BODY.track_contact_length_m, initial=VEHICLE.soil,

@@ -154,18 +154,24 @@ class HullSection:
                     + self.strut_width_m * max(d - self.float_depth_m, 0.0))
         return self.area_array_m2(np.asarray(depth_m, dtype=float))
 
-    def area_array_m2(self, depth_m: np.ndarray) -> np.ndarray:
+    def area_array_m2(self, depth_m: np.ndarray,
+                      max_depth_m: float | None = None) -> np.ndarray:
         """``area_m2`` of a float array (the simulator's strips, every step), same bits.
 
-        The segment's clips fold into one: min(max(d, 0), min(float_depth, 2r)) selects the
-        same value as clipping min(d, float_depth) into [0, 2r], and then |r - d| <= r, so
-        the clip of (r - d) / r into [-1, 1] never acts (correctly rounded division).
+        ``max_depth_m``: depth_m.max() if the caller has it; the deck's clip (below the deck)
+        and the strut's part (all below the float line) are then skipped where they add
+        nothing. The segment's clips fold into one: min(max(d, 0), min(float_depth, 2r))
+        selects the same value as clipping min(d, float_depth) into [0, 2r], and then
+        |r - d| <= r, so the clip of (r - d) / r into [-1, 1] never acts (correctly rounded
+        division), nor does the clip of r^2 - h^2 at 0 (correctly rounded products are
+        monotonic: |h| <= r gives h h <= r r).
         """
         r = self.radius_m
-        d = np.minimum(depth_m, self.top_depth_m)
-        # in place, the same operations on the same operands as
+        deck = max_depth_m is None or max_depth_m > self.top_depth_m
+        d = np.minimum(depth_m, self.top_depth_m) if deck else depth_m
+        # the same operations on the same operands as
         # h = r - min(max(d, 0), min(float_depth, 2r));
-        # r^2 acos(h / r) - h sqrt(max(r^2 - h^2, 0)) + strut max(d - float_depth, 0)
+        # r^2 acos(h / r) - h sqrt(r^2 - h^2) + strut max(d - float_depth, 0)
         h = np.maximum(d, 0.0)
         np.minimum(h, min(self.float_depth_m, 2.0 * r), out=h)
         np.subtract(r, h, out=h)
@@ -174,11 +180,12 @@ class HullSection:
         out *= r * r
         root = h * h
         np.subtract(r * r, root, out=root)
-        np.maximum(root, 0.0, out=root)
         np.sqrt(root, out=root)
         root *= h
         out -= root
-        strut = np.subtract(d, self.float_depth_m, out=d)
+        if max_depth_m is not None and max_depth_m <= self.float_depth_m:
+            return out                        # the strut's part is +0.0 everywhere
+        strut = np.subtract(d, self.float_depth_m, out=d if deck else None)
         np.maximum(strut, 0.0, out=strut)
         strut *= self.strut_width_m
         out += strut

@@ -153,3 +153,20 @@ def test_the_scalar_section_gives_the_array_section_bit_for_bit():
     for other in (HullSection(0.3, 0.6, 0.2), HullSection(0.3, 0.0, 0.1, 0.5)):
         depths = np.array([*edges, *np.random.default_rng(6).uniform(-0.2, 1.2, 2000)])
         assert [other.area_m2(float(d)) for d in depths] == other.area_array_m2(depths).tolist()
+
+
+def test_the_deepest_depth_hint_skips_only_what_adds_nothing():
+    """area_array_m2 with the caller's max depth: the same bits, the input left as it was."""
+    import numpy as np
+
+    from dukw_model.buoyancy import HullSection
+    rng = np.random.default_rng(7)
+    for section in (HullSection(0.3, 0.45, 0.2, 0.9), HullSection(0.3, 0.6, 0.2),
+                    HullSection(0.3, 0.0, 0.1, 0.5)):
+        for lo, hi in ((-0.2, 0.44), (-0.2, 0.85), (0.1, 1.2), (0.0, 0.0)):
+            depths = rng.uniform(lo, hi, 16)
+            kept = depths.copy()
+            hinted = section.area_array_m2(depths, float(depths.max()))
+            assert np.array_equal(depths, kept)
+            assert hinted.tolist() == section.area_array_m2(depths.copy()).tolist()
+            assert hinted.tolist() == [section.area_m2(float(d)) for d in depths]

@@ -66,6 +66,68 @@ def sum_wrenches(terms: list[Wrench]) -> BodyForces:
     return BodyForces(*total)
 
 
+class StripSums(NamedTuple):
+    """Sums over the hull strips weighted by their immersed section areas a_i (m^2): of 1 and
+    of the water's velocity (vx, vy) and acceleration (ax, ay) at the strips (odom), each
+    also times the strips' body x_i, y_i, x_i^2 and y_i^2. The buoyancy, the wave forces,
+    their moments (each direction with its own inertia coefficient) and the water's yaw rate
+    (each direction weighted by its drag) are all linear in these: one matrix product per
+    step (``strip_sums``) gives them all (the x2_, y2_ kinematic sums come with it, unused)."""
+
+    area_m2: float
+    vx: float
+    vy: float
+    ax: float
+    ay: float
+    area_x_m3: float
+    x_vx: float
+    x_vy: float
+    x_ax: float
+    x_ay: float
+    area_y_m3: float
+    y_vx: float
+    y_vy: float
+    y_ax: float
+    y_ay: float
+    area_x2_m4: float
+    x2_vx: float
+    x2_vy: float
+    x2_ax: float
+    x2_ay: float
+    area_y2_m4: float
+    y2_vx: float
+    y2_vy: float
+    y2_ax: float
+    y2_ay: float
+
+
+def strip_basis(station_x_m: np.ndarray, station_y_m: np.ndarray) -> np.ndarray:
+    """The strips' (5, N) rows 1, x, y, x^2, y^2 that ``strip_sums`` weights (keep it)."""
+    x = np.asarray(station_x_m, dtype=float)
+    y = np.asarray(station_y_m, dtype=float)
+    return np.ascontiguousarray(np.vstack([np.ones_like(x), x, y, x * x, y * y]))
+
+
+def strip_sums(areas_m2: np.ndarray, water: WaterSample, basis: np.ndarray) -> StripSums:
+    """The area-weighted sums of ``StripSums`` of the N strips (``basis`` from
+    ``strip_basis``; the water's kinematics at the strips are its first N points)."""
+    n = areas_m2.size
+    kin = np.array((basis[0], water.velocity_x_mps[:n], water.velocity_y_mps[:n],
+                    water.accel_x_mps2[:n], water.accel_y_mps2[:n]))
+    return StripSums(*np.dot(basis * areas_m2, kin.T).ravel().tolist())   # dot: @ bits, cheaper
+
+
+def _sums_of(sums: StripSums | None, areas_m2: np.ndarray, water: WaterSample,
+             station_x_m: np.ndarray | None = None,
+             station_y_m: np.ndarray | None = None) -> StripSums:
+    """The given sums, else those of these strips (at the body's origin if not placed)."""
+    if sums is not None:
+        return sums
+    if station_x_m is None:
+        station_x_m = station_y_m = np.zeros(areas_m2.size)
+    return strip_sums(areas_m2, water, strip_basis(station_x_m, station_y_m))
+
+
 class Immersion(NamedTuple):
     """The hull strips in the water: their buoyancy, the volume and its afloat share."""
 
@@ -76,10 +138,13 @@ class Immersion(NamedTuple):
 
 
 def immersion(areas_m2: np.ndarray, strip_length_m: float, rho_g: float,
-              afloat_volume_m3: float) -> Immersion:
-    """Buoyancy of the hull strips with these immersed section areas."""
+              afloat_volume_m3: float, area_sum_m2: float | None = None) -> Immersion:
+    """Buoyancy of the hull strips with these immersed section areas (``area_sum_m2``:
+    their sum, if the caller has it)."""
     strip_f = rho_g * strip_length_m * areas_m2
-    buoy = float(strip_f.sum())
+    if area_sum_m2 is None:
+        area_sum_m2 = float(areas_m2.sum())
+    buoy = rho_g * strip_length_m * area_sum_m2
     volume = buoy / rho_g
     return Immersion(strip_f, buoy, volume, min(volume / afloat_volume_m3, 1.0))
 
@@ -95,31 +160,30 @@ class WaveForcing(NamedTuple):
 
 def wave_forcing(calm: bool, areas_m2: np.ndarray, strip_length_m: float, water: WaterSample,
                  waves: WaveParams, rho_kgpm3: float, rho_g: float, amplitude_sq_m2: float,
-                 beam_m: float, imm: Immersion) -> WaveForcing:
-    """Froude-Krylov + diffraction on the hull strips, less the mean drift (shoreward)."""
+                 beam_m: float, imm: Immersion, sums: StripSums | None = None) -> WaveForcing:
+    """Froude-Krylov + diffraction on the hull strips, less the mean drift (shoreward).
+    ``sums``: the strips' ``strip_sums`` if the caller has them."""
     if calm:
         return WaveForcing(0.0, 0.0, 0.0, 0.0)
-    cm_rho = waves.surge_inertia_coeff * rho_kgpm3
-    vol_strip = areas_m2 * strip_length_m
-    fwx = cm_rho * float(vol_strip @ water.accel_x_mps2)
-    fwy = cm_rho * float(vol_strip @ water.accel_y_mps2)
+    sums = _sums_of(sums, areas_m2, water)
+    cm_rho_l = waves.surge_inertia_coeff * rho_kgpm3 * strip_length_m
+    fwx = cm_rho_l * sums.ax
+    fwy = cm_rho_l * sums.ay
     drift = (waves.drift_force_coeff * 0.5 * rho_g
              * amplitude_sq_m2
              * beam_m * imm.fraction)
     fwx -= drift                                    # shoreward, with the waves
     if imm.volume_m3 > 1e-9:
-        area_sum = float(areas_m2.sum())
-        wu = float(areas_m2 @ water.velocity_x_mps) / area_sum
-        wv = float(areas_m2 @ water.velocity_y_mps) / area_sum
+        wu = sums.vx / sums.area_m2
+        wv = sums.vy / sums.area_m2
     else:
         wu = wv = 0.0
     return WaveForcing(fwx, fwy, wu, wv)
 
 
 def water_yaw_rate_rps(areas_m2: np.ndarray, water: WaterSample, station_x_m: np.ndarray,
-                       station_y_m: np.ndarray, yaw_cs: tuple,
-                       radius_sq_m2: np.ndarray | None = None,
-                       surge_to_sway_drag: float = 1.0) -> float:
+                       station_y_m: np.ndarray, yaw_cs: tuple, surge_to_sway_drag: float = 1.0,
+                       sums: StripSums | None = None) -> float:
     """The water's own yaw rate over the hull: the rotation of the wave particle velocity at
     the immersed strips that the hull's drag acts against (body axes), rad/s.
 
@@ -129,19 +193,16 @@ def water_yaw_rate_rps(areas_m2: np.ndarray, water: WaterSample, station_x_m: np
     drag act on u and v minus the water's mean velocity (``wave_forcing``). Each strip's
     relative velocity is weighted by the drag it meets in that direction: the transverse
     (cross-flow) one by the sway drag, the longitudinal one by ``surge_to_sway_drag`` times
-    it (1: the least-squares rotation, immersed area as weight). ``radius_sq_m2``: the
-    strips' x^2 + surge_to_sway_drag y^2 if the caller keeps it."""
-    if radius_sq_m2 is None:
-        radius_sq_m2 = station_x_m ** 2 + surge_to_sway_drag * station_y_m ** 2
-    weight = float(areas_m2 @ radius_sq_m2)
+    it (1: the least-squares rotation, immersed area as weight). ``sums``: the strips'
+    ``strip_sums`` if the caller has them."""
+    sums = _sums_of(sums, areas_m2, water, station_x_m, station_y_m)
+    w = surge_to_sway_drag
+    weight = sums.area_x2_m4 + w * sums.area_y2_m4          # sum of a (x^2 + w y^2)
     if weight <= 1e-12:
         return 0.0
     c, s = yaw_cs
-    n = station_x_m.size
-    vel_x, vel_y = water.velocity_x_mps[:n], water.velocity_y_mps[:n]
-    ub = c * vel_x + s * vel_y
-    vb = -s * vel_x + c * vel_y
-    return float(areas_m2 @ (station_x_m * vb - surge_to_sway_drag * station_y_m * ub)) / weight
+    # sum of a (x vb - w y ub), with body-axes water velocity ub = c vx + s vy, vb = -s vx + c vy
+    return (c * (sums.x_vy - w * sums.y_vx) - s * (sums.x_vx + w * sums.y_vy)) / weight
 
 
 class WaveMoments(NamedTuple):
@@ -159,7 +220,8 @@ class WaveMoments(NamedTuple):
 def wave_moments(calm: bool, areas_m2: np.ndarray, strip_length_m: float, water: WaterSample,
                  waves: WaveParams, rho_kgpm3: float, station_x_m: np.ndarray,
                  station_y_m: np.ndarray, yaw_cs: tuple, lever_z_m: float,
-                 sway_inertia_coeff: float | None = None) -> WaveMoments:
+                 sway_inertia_coeff: float | None = None,
+                 sums: StripSums | None = None) -> WaveMoments:
     """Each strip's Froude-Krylov + diffraction force acting at the strip: its horizontal
     offset from the centre of gravity gives the yaw moment, its height ``lever_z_m`` relative
     to it (< 0: below) the roll and pitch moments. In a short-crested sea the transverse
@@ -171,25 +233,23 @@ def wave_moments(calm: bool, areas_m2: np.ndarray, strip_length_m: float, water:
     across them ``sway_inertia_coeff`` (1 + the sway added-mass ratio: the added mass the
     body's sway inertia carries is the same that the accelerating water exerts; None: the
     surge one). The transverse force beyond the surge coefficient's is returned (odom) for
-    the total force."""
+    the total force. ``sums``: the strips' ``strip_sums`` if the caller has them."""
     if calm:
         return WaveMoments(0.0, 0.0, 0.0)
+    sums = _sums_of(sums, areas_m2, water, station_x_m, station_y_m)
     c, s = yaw_cs
-    rho_v = rho_kgpm3 * areas_m2 * strip_length_m
+    rho_l = rho_kgpm3 * strip_length_m
     cm_x = waves.surge_inertia_coeff
     cm_y = cm_x if sway_inertia_coeff is None else sway_inertia_coeff
-    ax, ay = water.accel_x_mps2, water.accel_y_mps2
-    along = rho_v * (c * ax + s * ay)           # body axes, per unit C_m
-    across = rho_v * (-s * ax + c * ay)
-    f_along = cm_x * along
-    f_across = cm_y * across
-    fx = c * f_along - s * f_across             # odom
-    fy = s * f_along + c * f_across
-    off_x = c * station_x_m - s * station_y_m
-    off_y = s * station_x_m + c * station_y_m
-    yaw = float(off_x @ fy - off_y @ fx)
-    fx_body, fy_body = float(f_along.sum()), float(f_across.sum())
-    extra = (cm_y - cm_x) * float(across.sum())
+    # the strips' body-axes accelerations, area-weighted: along = c ax + s ay, across =
+    # -s ax + c ay; the force along is cm_x rho l along, across cm_y rho l across; the yaw
+    # moment sum of x f_across - y f_along (the cross product is the same in body axes)
+    across = -s * sums.ax + c * sums.ay
+    fx_body = cm_x * rho_l * (c * sums.ax + s * sums.ay)
+    fy_body = cm_y * rho_l * across
+    yaw = rho_l * (cm_y * (c * sums.x_ay - s * sums.x_ax)
+                   - cm_x * (c * sums.y_ax + s * sums.y_ay))
+    extra = (cm_y - cm_x) * rho_l * across
     # REP 103: a force to port below the centre of gravity lifts the port side (+ roll); a
     # force forward below it lifts the bow (- pitch)
     return WaveMoments(yaw, -lever_z_m * fy_body, lever_z_m * fx_body, -s * extra, c * extra)

@@ -73,9 +73,10 @@ class HullGeometry:
         deck (``buoyancy.HullSection``, the estimator's section too).
         """
         d = depth_over_bottom_m
-        if d.max() <= 0.0:
+        deepest = float(d.max())
+        if deepest <= 0.0:
             return self._dry
-        return self.section.area_array_m2(d)
+        return self.section.area_array_m2(d, deepest)
 
 
 @dataclass(frozen=True)

@@ -74,29 +74,46 @@ def _compliant_speeds(patch: traction.TrackPatch, strength: float, ref: list, gr
 
     h(v) = F_soil(v, g) + others - k (ref - v) rises with v; safeguarded Newton inside the
     bracket the soil's strength S gives: v in [ref - (S + o)/k, ref + (S - o)/k]. Both tracks
-    step together until both have converged; in floats (numpy on two tracks costs more than
-    the physics), the same bits as the vectorised form. Returns the speeds and, when they
-    converged, the soil forces there (else None).
+    step together until both have converged; in floats, the two tracks written out (numpy on
+    two tracks, or lists of two, cost more than the physics), the same bits as the vectorised
+    form. Returns the speeds and, when they converged, the soil forces there (else None).
     """
     force = traction.track_force_f
-    lo = [ref[i] - (strength + others[i]) / stiffness[i] for i in range(2)]
-    hi = [ref[i] + (strength - others[i]) / stiffness[i] for i in range(2)]
-    v = [min(max(guess[i], lo[i]), hi[i]) for i in range(2)]
+    r0, r1 = ref
+    g0, g1 = ground
+    o0, o1 = others
+    k0, k1 = stiffness
+    lo0, lo1 = r0 - (strength + o0) / k0, r1 - (strength + o1) / k1
+    hi0, hi1 = r0 + (strength - o0) / k0, r1 + (strength - o1) / k1
+    v0, v1 = min(max(guess[0], lo0), hi0), min(max(guess[1], lo1), hi1)
     for _ in range(_COMPLIANCE_ITERATIONS):
-        f = [force(patch, v[0], ground[0]), force(patch, v[1], ground[1])]
-        h = [f[i] + others[i] - stiffness[i] * (ref[i] - v[i]) for i in range(2)]
-        if abs(h[0]) < _COMPLIANCE_TOL_N and abs(h[1]) < _COMPLIANCE_TOL_N:
-            return v, f
-        for i in range(2):
-            if h[i] > 0.0:
-                hi[i] = v[i]
-            else:
-                lo[i] = v[i]
-            slope = (force(patch, v[i] + _PROBE_MPS, ground[i]) - f[i]) / _PROBE_MPS \
-                + stiffness[i]
-            step = v[i] - h[i] / slope
-            v[i] = step if lo[i] < step < hi[i] else 0.5 * (lo[i] + hi[i])
-    return v, None
+        f0, f1 = force(patch, v0, g0), force(patch, v1, g1)
+        h0, h1 = f0 + o0 - k0 * (r0 - v0), f1 + o1 - k1 * (r1 - v1)
+        if abs(h0) < _COMPLIANCE_TOL_N and abs(h1) < _COMPLIANCE_TOL_N:
+            return [v0, v1], [f0, f1]
+        if h0 > 0.0:
+            hi0 = v0
+        else:
+            lo0 = v0
+        step = v0 - h0 / ((force(patch, v0 + _PROBE_MPS, g0) - f0) / _PROBE_MPS + k0)
+        v0 = step if lo0 < step < hi0 else 0.5 * (lo0 + hi0)
+        if h1 > 0.0:
+            hi1 = v1
+        else:
+            lo1 = v1
+        step = v1 - h1 / ((force(patch, v1 + _PROBE_MPS, g1) - f1) / _PROBE_MPS + k1)
+        v1 = step if lo1 < step < hi1 else 0.5 * (lo1 + hi1)
+    return [v0, v1], None
+
+
+def _derivatives(patch: traction.TrackPatch, speed: float, ground: float, f0: float,
+                 stiffness: float, soft: bool) -> float:
+    """d force / d ground speed of one track at (speed, ground) with force f0 there: the
+    soil's, or with a soft loop the series one D_g k / (k + D_t)."""
+    force = traction.track_force_f
+    d_g = (force(patch, speed, ground + _PROBE_MPS) - f0) / _PROBE_MPS
+    d_t = (force(patch, speed + _PROBE_MPS, ground) - f0) / _PROBE_MPS
+    return d_g * stiffness / (stiffness + d_t) if soft else d_g
 
 
 def linearise(contact: TrackContact | None, ref_mps: tuple, ground_mps: tuple,
@@ -111,30 +128,26 @@ def linearise(contact: TrackContact | None, ref_mps: tuple, ground_mps: tuple,
     """
     if contact is None:
         return TrackLinear([0.0, 0.0], [0.0, 0.0], list(ref_mps))
-    ref = [float(r) for r in ref_mps]
-    ground = [float(g) for g in ground_mps]
-    stiff = [float(k) for k in stiffness_n_per_mps]
-    soft = [math.isfinite(k) for k in stiff]
+    ref = [float(ref_mps[0]), float(ref_mps[1])]
+    ground = [float(ground_mps[0]), float(ground_mps[1])]
+    stiff = [float(stiffness_n_per_mps[0]), float(stiffness_n_per_mps[1])]
+    soft = [math.isfinite(stiff[0]), math.isfinite(stiff[1])]
     patch = contact.patch
     force = traction.track_force_f
     speed = ref
     f0 = None
     if soft[0] or soft[1]:
-        guess = ref if guess_mps is None else [float(g) for g in guess_mps]
-        k_soft = [stiff[i] if soft[i] else 1.0 for i in range(2)]
+        guess = ref if guess_mps is None else [float(guess_mps[0]), float(guess_mps[1])]
+        k_soft = [stiff[0] if soft[0] else 1.0, stiff[1] if soft[1] else 1.0]
         loaded, f_loaded = _compliant_speeds(patch, contact.strength_n(slipping=True), ref,
-                                             ground, [float(o) for o in others_n], k_soft,
-                                             guess)
-        speed = [loaded[i] if soft[i] else ref[i] for i in range(2)]
+                                             ground, [float(others_n[0]), float(others_n[1])],
+                                             k_soft, guess)
+        speed = [loaded[0] if soft[0] else ref[0], loaded[1] if soft[1] else ref[1]]
         if f_loaded is not None and soft[0] and soft[1]:
             f0 = f_loaded                           # the forces at the converged speeds
     if f0 is None:
-        f0 = [force(patch, speed[i], ground[i]) for i in range(2)]
-    d_g = [(force(patch, speed[i], ground[i] + _PROBE_MPS) - f0[i]) / _PROBE_MPS
-           for i in range(2)]
-    d_t = [(force(patch, speed[i] + _PROBE_MPS, ground[i]) - f0[i]) / _PROBE_MPS
-           for i in range(2)]
-    d_g = [d_g[i] * stiff[i] / (stiff[i] + d_t[i]) if soft[i] else d_g[i] for i in range(2)]
+        f0 = [force(patch, speed[0], ground[0]), force(patch, speed[1], ground[1])]
+    d_g = [_derivatives(patch, speed[i], ground[i], f0[i], stiff[i], soft[i]) for i in (0, 1)]
     return TrackLinear(f0, d_g, list(speed))
 
 

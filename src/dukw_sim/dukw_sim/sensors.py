@@ -17,6 +17,7 @@ ENU. Errors of the IMU's attitude and of the DGPS position drift slowly
 from __future__ import annotations
 
 import math
+import dataclasses
 from dataclasses import dataclass
 from enum import IntFlag
 from typing import Mapping
@@ -209,6 +210,35 @@ def _positive(params: Mapping[str, ParamValue], name: str) -> float:
     return value
 
 
+def positional_builder(cls: type):
+    """A function building ``cls`` (a frozen, slotted dataclass) from all its fields given
+    positionally, about 4x cheaper than its __init__ (which sets each field through
+    object.__setattr__): an unfrozen slotted twin with the same fields (so the same slot
+    layout) is built and takes ``cls`` as its class. The result is an ordinary ``cls``:
+    equal to ``cls(*values)``, frozen, hashable. No defaults and no __post_init__ checks:
+    for the sensor models' own readings, whose values are floats they computed."""
+    if not dataclasses.is_dataclass(cls) or '__slots__' not in vars(cls):
+        raise TypeError(f'{cls.__name__} is not a slotted dataclass')
+    twin = dataclasses.make_dataclass(
+        f'_{cls.__name__}Fields', [(f.name, f.type) for f in dataclasses.fields(cls)],
+        slots=True)
+
+    def build(*values):
+        obj = twin(*values)
+        obj.__class__ = cls
+        return obj
+    return build
+
+
+_imu_sample = positional_builder(ImuSample)
+_motor_side = positional_builder(MotorSide)
+_gps_fix = positional_builder(GpsFix)
+_gps_velocity = positional_builder(GpsVelocity)
+_water_contact = positional_builder(WaterContact)
+_depth_reading = positional_builder(DepthReading)
+_drive_status = positional_builder(DriveStatus)    # drive: 'tracks' or 'props', ours below
+
+
 # ----------------------------------------------------------------------------- helpers
 
 class NoiseStream:
@@ -361,6 +391,7 @@ class SensorModel:
                        'gps_vel': NoiseStream(rngs[2], 3), 'water': NoiseStream(rngs[3], 2),
                        'depth': NoiseStream(rngs[4], 1), 'tracks': NoiseStream(rngs[5], 6),
                        'props': NoiseStream(rngs[6], 6)}
+        self._imu_noise = self._noise['imu']
         first = rngs[7].standard_normal(9).tolist()
         self._gyro_bias = tuple(noise.gyro_bias_std_rps * d for d in first[:3])
         att, head, tau = noise.attitude_std_rad, noise.heading_std_rad, noise.attitude_tau_s
@@ -413,8 +444,9 @@ class SensorModel:
         """The IMU at imu_link: its EKF's attitude, gyro rates with bias, specific force."""
         noise, h = self.config.noise, self.config.mounts.imu_z_m
         dt = self._dt('imu', truth.t_s)
-        d = self._noise['imu'].draw()
-        err = [e.step(dt, d[6 + k]) for k, e in enumerate(self._attitude_error)]
+        d = self._imu_noise.draw()
+        roll_err, pitch_err, head_err = self._attitude_error
+        err = (roll_err.step(dt, d[6]), pitch_err.step(dt, d[7]), head_err.step(dt, d[8]))
         wx, wy, wz = truth.roll_rate_rps, truth.pitch_rate_rps, truth.yaw_rate_rps
         last = self._last_rates
         if last is not None and dt > 0:
@@ -428,13 +460,12 @@ class SensorModel:
         bias, g = self._gyro_bias, noise.gyro_std_rps
         sx, sy, sz = noise.accel_x_std_mps2, noise.accel_y_std_mps2, noise.accel_z_std_mps2
         head2, g2, att2, accel_var = self._imu_var
-        return ImuSample(
+        return _imu_sample(      # ImuSample's fields in order (variances: yaw, yaw rate,
+            # roll, pitch, roll rate, pitch rate, accel)
             truth.t_s, truth.roll_rad + err[0], truth.pitch_rad + err[1], truth.yaw_rad + err[2],
             wx + bias[0] + g * d[0], wy + bias[1] + g * d[1], wz + bias[2] + g * d[2],
             fx + sx * d[3], fy + sy * d[4], fz + sz * d[5],
-            yaw_var_rad2=head2, yaw_rate_var_rps2=g2, roll_var_rad2=att2,
-            pitch_var_rad2=att2, roll_rate_var_rps2=g2, pitch_rate_var_rps2=g2,
-            accel_var_m2ps4=accel_var)
+            head2, g2, att2, att2, g2, g2, accel_var)
 
     def antenna_enu(self, truth: Truth) -> tuple[float, float, float]:
         """True position of the GPS antenna in odom (ENU), m: base_link + R (0, 0, h)."""
@@ -453,8 +484,7 @@ class SensorModel:
                                                 datum.latitude_deg, datum.longitude_deg,
                                                 datum.altitude_m)
         h2, v2 = noise.gps_horizontal_std_m ** 2, noise.gps_vertical_std_m ** 2
-        return GpsFix(truth.t_s, lat, lon, alt, horizontal_var_m2=h2, valid=True,
-                      vertical_var_m2=v2)
+        return _gps_fix(truth.t_s, lat, lon, alt, h2, True, v2)   # h. var, valid, v. var
 
     def gps_velocity(self, truth: Truth) -> GpsVelocity:
         """DGPS velocity of the antenna, ENU: body velocity plus w x r, rotated; white noise."""
@@ -463,8 +493,8 @@ class SensorModel:
         u, v = sensor_point_velocity_body(truth.surge_mps, truth.sway_mps,
                                           truth.roll_rate_rps, truth.pitch_rate_rps, h)
         cy, sy = math.cos(truth.yaw_rad), math.sin(truth.yaw_rad)
-        return GpsVelocity(truth.t_s, cy * u - sy * v + s * d[0], sy * u + cy * v + s * d[1],
-                           var_mps2=s * s, up_mps=truth.heave_mps + s * d[2], up_var_mps2=s * s)
+        return _gps_velocity(truth.t_s, cy * u - sy * v + s * d[0], sy * u + cy * v + s * d[1],
+                             s * s, truth.heave_mps + s * d[2], s * s)   # var, up, up var
 
     def water(self, truth: Truth) -> WaterContact:
         """Water contact: the level ramps 0 -> 1 across the lead gap around the sensor point."""
@@ -473,8 +503,8 @@ class SensorModel:
         gap = max(water.lead_gap_m, 1e-6)
         fore = _clip01(0.5 + truth.fore_sensor_depth_m / gap + s * d[0])
         aft = _clip01(0.5 + truth.aft_sensor_depth_m / gap + s * d[1])
-        return WaterContact(truth.t_s, self._fore.update(fore >= water.wet_level),
-                            self._aft.update(aft >= water.wet_level), fore, aft)
+        return _water_contact(truth.t_s, self._fore.update(fore >= water.wet_level),
+                              self._aft.update(aft >= water.wet_level), fore, aft)
 
     def depth(self, truth: Truth) -> DepthReading:
         """Depth below the transducer; invalid (NaN) out of water or shallower than the minimum."""
@@ -483,8 +513,8 @@ class SensorModel:
         valid = (truth.sounder_depth_m > 0.0
                  and truth.water_depth_m > cfg.mounts.depth_sounder_min_m)
         depth_m = truth.sounder_depth_m + cfg.noise.depth_std_m * d[0] if valid else math.nan
-        return DepthReading(truth.t_s, valid, depth_m, cfg.depth.offset_m,
-                            cfg.depth.water_temp_c)
+        return _depth_reading(truth.t_s, valid, depth_m, cfg.depth.offset_m,
+                              cfg.depth.water_temp_c)
 
     def tracks(self, truth: Truth) -> DriveStatus:
         """The tracks' controller: command, current, pack voltage, belt speed, force = I x gain."""
@@ -526,8 +556,8 @@ class SensorModel:
             flags = channel.update(dt, currents[i], stalling, voltage, under_v)
             current = currents[i] + noise.current_std_a * d[3 * i]
             speed = 0.0 if speeds is None else true_speed + noise.speed_std_mps * d[3 * i + 1]
-            sides.append(MotorSide(
+            sides.append(_motor_side(      # MotorSide's fields in order
                 commands[i], current, speed, force_n(current, commands[i]),
                 voltage + noise.voltage_std_v * d[3 * i + 2], channel.temperature_c,
                 flags, fault_names(flags)))
-        return DriveStatus(truth.t_s, sides[0], sides[1], True, drive)
+        return _drive_status(truth.t_s, sides[0], sides[1], True, drive)   # connected

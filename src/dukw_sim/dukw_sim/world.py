@@ -22,6 +22,10 @@ import numpy as np
 GRAVITY_MPS2 = 9.81
 # np.interp without its Python wrapper (real values: the wrapper calls this, same result)
 _interp = getattr(getattr(np, '_core', None), 'multiarray', np).interp
+_REACH_MARGIN_M = 1e-6     # a point's |R b| against its rounded odom x
+# np.dot, not @, for the per-step small products: the same BLAS call (same bits on these
+# contiguous float arrays) without matmul's ufunc overhead, ~0.5 us less each
+_dot = np.dot
 _MIN_KINEMATIC_DEPTH_M = 0.05
 
 
@@ -281,9 +285,19 @@ class World:
         self._wavenumbers[0], self._wavenumbers[1] = waves.kx, waves.ky
         self._wavenumbers[3] = -0.5 * math.pi
         self._time_key: float | None = None
+        # sample_rigid: [kx; ky; phase; omega], its (3, 4) coefficients and the phase matrix
+        self._rigid_waves = np.vstack([waves.kx, waves.ky, waves.phase_rad, waves.omega_rps])
+        self._rigid_coef = np.zeros((3, 4))
+        self._rigid_coef[2, 2] = 1.0
+        self._rigid_phase = np.zeros((4, waves.count))
+        self._reach_of: np.ndarray | None = None      # sample_rigid's rows, and their reach
+        self._offshore_depth: dict[int, float] = {}   # points over the sea floor: their depth
+        self._reach_m = math.inf
+        self._rigid_phase[3] = -0.5 * math.pi
+        self._rigid_odom = np.zeros(4)
         self._transfer_key: tuple[float, float] | None = None
         self._sinh_depth: float | None = None
-        self._sinh_kd = np.zeros(0)
+        self._kin_per_sinh = np.zeros((0, 4))
         self._points = np.zeros((0, 4))
         self._points_key = (0, 0)
         self._still_x = np.array([beach.flat_start_x_m, beach.sea_floor_x_m])
@@ -362,35 +376,99 @@ class World:
         """``sample`` of flat float arrays x, y of n points, 0 <= kin_points <= n, waves
         present and some point seaward of the waterline (the simulator's call every step,
         without the checks)."""
-        n = x.size
         rows = self._point_rows(x, y, kin_points)
         trig = np.cos(rows @ self._phase_matrix(t_s))   # cos on the first n rows, then sin
-        factor = _interp(rows[:, 0], self._cap_x, self._cap)
+        return self._combine(trig, rows[:, 0], x.size, kin_points, kin_height_m)
+
+    def rigid_rows(self, body_x_m: np.ndarray, body_y_m: np.ndarray,
+                   kin_points: int) -> np.ndarray:
+        """The rows ``sample_rigid`` takes for points fixed in a body (body frame x, y):
+        [x, y, 1, 0] of every point, then [x, y, 1, 1] of the first ``kin_points``."""
+        bx = np.asarray(body_x_m, dtype=float).ravel()
+        by = np.asarray(body_y_m, dtype=float).ravel()
+        if bx.shape != by.shape or not 0 <= kin_points <= bx.size:
+            raise ValueError('rigid_rows needs x and y of the same size, 0 <= kin_points <= n')
+        rows = np.zeros((bx.size + kin_points, 4))
+        rows[:bx.size, 0], rows[:bx.size, 1] = bx, by
+        rows[bx.size:, :2] = rows[:kin_points, :2]
+        rows[:, 2] = 1.0
+        rows[bx.size:, 3] = 1.0
+        return rows
+
+    def sample_rigid(self, rows: np.ndarray, n: int, x_m: float, y_m: float, cos_yaw: float,
+                     sin_yaw: float, t_s: float,
+                     kin_height_m: float) -> tuple[np.ndarray, WaterSample]:
+        """``sample`` at n points fixed in a body whose origin is at (x, y) with this heading
+        (``rows`` from ``rigid_rows``; the kinematics at the rows after the n-th), and the
+        points' odom x (one value per row).
+
+        A point's phase k.(X + R b) + phase - omega t is b_x (R^T k)_x + b_y (R^T k)_y plus
+        the body origin's phase: one (3, 4) x (4, M) product per step gives the rotated
+        wavenumbers and the origin's phase, which is kept in [0, 2 pi) so that the cosines'
+        arguments stay small (a few radians over the body, not k x + omega t).
+        """
+        odom = self._rigid_odom
+        odom[0], odom[1], odom[2] = cos_yaw, -sin_yaw, x_m
+        px = _dot(rows, odom)
+        kin_points = rows.shape[0] - n
+        if rows is not self._reach_of:            # the points' farthest reach from the origin
+            self._reach_m = float(np.hypot(rows[:, 0], rows[:, 1]).max()) + _REACH_MARGIN_M
+            self._reach_of = rows
+        seaward_x = x_m - self._reach_m           # no point is nearer the beach than this
+        if self._calm or (seaward_x <= 0.0 and px[:n].max() <= 0.0):  # calm, or on the sand
+            kin = np.zeros(kin_points)
+            return px, WaterSample(np.zeros(n), kin, kin, kin, kin)
+        coef = self._rigid_coef
+        coef[0, 0] = coef[1, 1] = cos_yaw
+        coef[0, 1], coef[1, 0] = sin_yaw, -sin_yaw
+        coef[2, 0], coef[2, 1], coef[2, 3] = x_m, y_m, -t_s
+        phase = self._rigid_phase
+        _dot(coef, self._rigid_waves, out=phase[:3])
+        np.remainder(phase[2], 2.0 * math.pi, out=phase[2])
+        trig = np.cos(_dot(rows, phase))            # cos on the first n rows, then sin
+        # every point where the breaking cap is 1 (np.interp gives fp[-1] exactly there)
+        uncapped = seaward_x >= self._cap_x[1] and self._cap[1] == 1.0
+        return px, self._combine(trig, px, n, kin_points, kin_height_m, uncapped,
+                                 seaward_x >= self._still_x[1])
+
+    def _combine(self, trig: np.ndarray, row_x: np.ndarray, n: int, kin_points: int,
+                 kin_height_m: float, uncapped: bool = False,
+                 offshore: bool = False) -> WaterSample:
+        """Elevation and kinematics from the rows' cosines (then sines) of the phases
+        (``uncapped``: every row where the breaking cap is 1, the factor is skipped;
+        ``offshore``: every row over the flat sea floor)."""
         if kin_points:
-            self._set_transfer(x[:kin_points], kin_height_m)
-            out = trig @ self._weights
+            self._set_transfer(row_x[:kin_points], kin_height_m, offshore)
+            out = _dot(trig, self._weights)
         else:
             out = trig @ self._weights[:, :1]
-        out *= factor[:, None]
+        if not uncapped:
+            out *= _interp(row_x, self._cap_x, self._cap)[:, None]
         if not kin_points:
             kin = np.zeros(0)
             return WaterSample(out[:n, 0], kin, kin, kin, kin)
         return WaterSample(out[:n, 0], out[:kin_points, 1], out[:kin_points, 2], out[n:, 3],
                            out[n:, 4])
 
-    def _set_transfer(self, x_kin: np.ndarray, kin_height_m: float) -> None:
-        """Kinematic weights times cosh k(z + d) / sinh k d at the points' mean still depth."""
-        depth = float(_interp(x_kin, self._still_x, self._still_depth).sum()) / x_kin.size
-        depth = max(depth, _MIN_KINEMATIC_DEPTH_M)
+    def _set_transfer(self, x_kin: np.ndarray, kin_height_m: float,
+                      offshore: bool = False) -> None:
+        """Kinematic weights times cosh k(z + d) / sinh k d at the points' mean still depth
+        (``offshore``: all over the flat sea floor, where it is the same for any such points,
+        np.interp giving the floor's depth exactly: kept per number of points)."""
+        depth = self._offshore_depth.get(x_kin.size) if offshore else None
+        if depth is None:
+            depth = float(_interp(x_kin, self._still_x, self._still_depth).sum()) / x_kin.size
+            depth = max(depth, _MIN_KINEMATIC_DEPTH_M)
+            if offshore:
+                self._offshore_depth[x_kin.size] = depth
         zc = min(max(kin_height_m, -depth), 0.0)
         if (zc, depth) == self._transfer_key:     # e.g. the hull above the water
             return
         if depth != self._sinh_depth:             # e.g. off the slope: the sea floor's depth
-            self._sinh_kd = np.sinh(self._k * depth)
+            self._kin_per_sinh = self._kin_weights / np.sinh(self._k * depth)[:, None]
             self._sinh_depth = depth
         transfer = np.cosh(self._k * (zc + depth))
-        transfer /= self._sinh_kd
-        np.multiply(transfer[:, None], self._kin_weights, out=self._weights[:, 1:])
+        np.multiply(transfer[:, None], self._kin_per_sinh, out=self._weights[:, 1:])
         self._transfer_key = (zc, depth)
 
     def elevation_m(self, x_m: float, y_m: float, t_s: float) -> float:

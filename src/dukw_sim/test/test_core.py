@@ -101,7 +101,7 @@ def test_submerged_volume_is_the_shared_strip_model():
     sim = SimCore.from_config(overrides=WAVES, seed=1)
     sim.reset('surf')
     truth = run(sim, Actuation(30, 30), 150)
-    _, _, depths, _ = sim._hydro()
+    depths = sim._hydro().depths
     n = sim.hull.stations_per_hull
     r, length = sim.vehicle.body.hull_radius_m, sim.vehicle.body.hull_length_m
     d_float = sim.hull.float_depth_m

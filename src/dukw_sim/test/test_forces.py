@@ -9,8 +9,8 @@ import pytest
 from dukw_sim.core import SimCore
 from dukw_sim.forces import (Wrench, hydrodynamic_drag, lateral_resistance, mooring,
                              odom_force, propulsion, rolling_resistance, slope_gravity,
-                             saturated_share, sum_wrenches, surf_resistance, track_wetness,
-                             water_yaw_rate_rps, wave_moments)
+                             saturated_share, strip_basis, strip_sums, sum_wrenches,
+                             surf_resistance, track_wetness, water_yaw_rate_rps, wave_moments)
 from dukw_sim.world import WaterSample
 
 PARAMS = SimCore.from_config().params
@@ -251,3 +251,54 @@ def test_the_water_rotation_weights_each_strips_flow_by_its_drag(yaw_rad):
     spin = _flow(-0.2 * oy, 0.2 * ox)
     assert water_yaw_rate_rps(areas, spin, xs, ys, (c, s), surge_to_sway_drag=0.1) \
         == pytest.approx(0.2, rel=1e-12)
+
+
+def test_strip_sums_are_the_area_weighted_sums_strip_by_strip():
+    """The one matrix product the wave forces, moments and water yaw rate read."""
+    rng = np.random.default_rng(2)
+    xs, ys, areas = rng.uniform(-1, 1, 6), rng.uniform(-0.5, 0.5, 6), rng.uniform(0, 0.06, 6)
+    kin = rng.normal(size=(4, 9))          # more points than strips: the strips come first
+    water = WaterSample(np.zeros(9), *kin)
+    sums = strip_sums(areas, water, strip_basis(xs, ys))
+    weights = ((1.0, ''), (xs, 'x_'), (ys, 'y_'), (xs ** 2, 'x2_'), (ys ** 2, 'y2_'))
+    for weight, prefix in weights:
+        for row, name in zip(kin, ('vx', 'vy', 'ax', 'ay'), strict=True):
+            want = math.fsum(areas * weight * row[:6])
+            assert getattr(sums, prefix + name) == pytest.approx(want, rel=1e-13, abs=1e-15)
+    assert sums.area_m2 == pytest.approx(math.fsum(areas), rel=1e-14)
+    assert sums.area_x_m3 == pytest.approx(math.fsum(areas * xs), rel=1e-13)
+    assert sums.area_y_m3 == pytest.approx(math.fsum(areas * ys), rel=1e-13)
+    assert sums.area_x2_m4 == pytest.approx(math.fsum(areas * xs ** 2), rel=1e-13)
+    assert sums.area_y2_m4 == pytest.approx(math.fsum(areas * ys ** 2), rel=1e-13)
+    # the functions give the same with the caller's sums as with their own, with the drag
+    # weighting and the sway inertia coefficient too
+    c, s = math.cos(0.7), math.sin(0.7)
+    for drag_ratio in (1.0, 0.1):
+        assert water_yaw_rate_rps(areas, water, xs, ys, (c, s), drag_ratio, sums) == \
+            water_yaw_rate_rps(areas, water, xs, ys, (c, s), drag_ratio)
+    args = (False, areas, 0.3, water, PARAMS.waves, 1025.0, xs, ys, (c, s), -0.2)
+    for sway_cm in (None, 1.9):
+        assert wave_moments(*args, sway_cm, sums) == wave_moments(*args, sway_cm)
+
+
+def test_the_wave_moments_from_the_sums_are_the_strips_morison_forces():
+    """Strip by strip: C_m rho V a along the hull with the surge C_m, across it with the sway
+    C_m, at each strip's odom offset; the yaw moment, the body-axes totals (roll, pitch) and
+    the transverse force beyond the surge C_m's from the sums are the same."""
+    rng = np.random.default_rng(5)
+    xs, ys, areas = rng.uniform(-1, 1, 6), rng.uniform(-0.5, 0.5, 6), rng.uniform(0, 0.06, 6)
+    water = WaterSample(np.zeros(6), *rng.normal(size=(4, 6)))
+    c, s = math.cos(2.1), math.sin(2.1)
+    cm_x, cm_y, lever = PARAMS.waves.surge_inertia_coeff, 1.9, -0.2
+    rho_v = 1025.0 * areas * 0.3
+    ax, ay = water.accel_x_mps2, water.accel_y_mps2
+    f_along, f_across = cm_x * rho_v * (c * ax + s * ay), cm_y * rho_v * (-s * ax + c * ay)
+    fx, fy = c * f_along - s * f_across, s * f_along + c * f_across       # odom
+    yaw = math.fsum((c * xs - s * ys) * fy - (s * xs + c * ys) * fx)
+    extra = math.fsum((cm_y - cm_x) / cm_y * f_across)
+    got = wave_moments(False, areas, 0.3, water, PARAMS.waves, 1025.0, xs, ys, (c, s), lever,
+                       cm_y)
+    assert got.yaw_nm == pytest.approx(yaw, rel=1e-12)
+    assert got.roll_nm == pytest.approx(-lever * math.fsum(f_across), rel=1e-12)
+    assert got.pitch_nm == pytest.approx(lever * math.fsum(f_along), rel=1e-12)
+    assert (got.extra_fx_n, got.extra_fy_n) == pytest.approx((-s * extra, c * extra), rel=1e-12)

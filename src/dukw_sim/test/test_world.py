@@ -147,6 +147,35 @@ def test_vectorised_sample_matches_the_component_sum(spread):
     assert grid[1, 3] == pytest.approx(world.elevation_m(gx[1, 3], gy[1, 3], 4.0), abs=1e-12)
 
 
+def test_rigid_body_sample_is_the_sample_at_the_moved_points():
+    """sample_rigid (points fixed in a moving body, the simulator's per-step call) gives the
+    water of ``sample`` at those points in odom, to round-off, and their odom x."""
+    rng = np.random.default_rng(5)
+    world = World(beach(), irregular_waves(0.28, 3.6, 0.76, rng, count=24,
+                                           spreading_exponent_s=10.0, directions=6))
+    bx, by = rng.uniform(-1.5, 1.5, 10), rng.uniform(-0.5, 0.5, 10)
+    rows = world.rigid_rows(bx, by, 6)
+    full_cap_x = float(world._cap_x[1])        # seaward of this the breaking cap is 1
+    poses = ((12.0, 0.3, 2.9, 250.0), (3.0, -1.0, -0.4, 7.31), (-3.0, 0.0, 0.1, 1.0),
+             (0.4, 0.0, 1.0, 3.0),                                    # astride the waterline
+             (full_cap_x + 0.3, 0.0, 0.2, 9.0), (full_cap_x + 1.7, 0.0, 2.0, 9.0),  # cap's end
+             (world.beach.sea_floor_x_m + 1.7, 0.0, 0.5, 2.0),     # over the flat sea floor,
+             (world.beach.sea_floor_x_m + 2.0, 0.4, 0.1, 2.5))     # twice (its depth kept)
+    for x0, y0, yaw, t in poses:
+        c, s = math.cos(yaw), math.sin(yaw)
+        px, py = x0 + c * bx - s * by, y0 + s * bx + c * by
+        odom_x, rigid = world.sample_rigid(rows, 10, x0, y0, c, s, t, -0.2)
+        plain = world.sample(px, py, t, kin_points=6, kin_height_m=-0.2)
+        assert np.allclose(odom_x[:10], px, rtol=0.0, atol=1e-13)
+        assert np.allclose(odom_x[10:], px[:6], rtol=0.0, atol=1e-13)
+        for got, want in zip(rigid, plain, strict=True):
+            assert got.shape == want.shape
+            assert np.allclose(got, want, rtol=0.0, atol=1e-12)
+        assert np.any(rigid.elevation_m != 0.0) == (x0 != -3.0)  # that one: all on the sand
+    with pytest.raises(ValueError):
+        world.rigid_rows(bx, by, 11)
+
+
 def test_uniform_spread_sea_is_the_one_of_before_the_spreading_option():
     # waves.spreading_exponent_s = 0 with the uniform 0.35 rad spread (the default until
     # issue 13 made the cos-2s sea the default) keeps the sea of commit da3680a: these
