@@ -188,6 +188,10 @@ class SimCore:
         self._track_strips = np.flatnonzero(np.abs(self.hull.station_x_m)
                                             <= self._track_len / 2.0)
         self._wave_lever_z = params.wave_moments.transverse_force_z_m - self._kg
+        # Morison C_m = 1 + C_a across the hulls too (waves.moments.sway_inertia_from_added_mass)
+        self._sway_inertia_coeff = (1.0 + params.water.sway_added_mass_ratio
+                                    if params.wave_moments.sway_inertia_from_added_mass
+                                    else None)
         self._no_moments = WaveMoments(0.0, 0.0, 0.0)
         self._external = (0.0, 0.0, 0.0)
         self._valid_act: Actuation | None = None
@@ -199,7 +203,14 @@ class SimCore:
         self._ground_val = None
         self._over_tracks_of = None
         self._over_tracks = None
-        # the strips' rows 1, x, y, x^2 + y^2: their area-weighted sums (forces.strip_sums)
+        # the water's rotation the yaw damping acts against: each strip's cross-flow weighted
+        # by the sway drag, its along-hull flow by the surge drag (waves.moments.*)
+        wat = params.water
+        self._surge_to_sway_drag = (
+            wat.surge_linear_drag_n_per_mps / wat.sway_linear_drag_n_per_mps
+            if params.wave_moments.water_rotation_by_drag
+            and wat.sway_linear_drag_n_per_mps > 0.0 else 1.0)
+        # the strips' rows 1, x, y, x^2, y^2: their area-weighted sums (forces.strip_sums)
         self._strip_basis = strip_basis(self.hull.station_x_m, self.hull.station_y_m)
         self._strip_tilt = np.column_stack([-self.hull.station_x_m, self.hull.station_y_m])
         self._tilt_sines = np.zeros(2)
@@ -362,6 +373,9 @@ class SimCore:
         drives = self._track_drives(act, u_rel, w_eff, depths)
         thrust = self._thrust_n(act, water.elevation_m)
         moments = self._wave_moments(areas, water, (c, s), sums)
+        if moments.extra_fy_n or moments.extra_fx_n:   # the strips' sway inertia coefficient
+            waves = waves._replace(fx_n=waves.fx_n + moments.extra_fx_n,
+                                   fy_n=waves.fy_n + moments.extra_fy_n)
         forces = self._body_forces(drives, imm, waves, thrust, w_eff, (u_rel, v_rel, r_rel),
                                    (c, s), moments.yaw_nm)
         tracks = self._integrate_plane(forces, drives, imm.fraction, (c, s))
@@ -468,7 +482,7 @@ class SimCore:
         return wave_moments(self.world.calm, areas, self.hull.strip_length_m, water,
                             self.params.waves, self.vehicle.body.water_density_kgpm3,
                             self.hull.station_x_m, self.hull.station_y_m, yaw_cs,
-                            self._wave_lever_z, sums)
+                            self._wave_lever_z, self._sway_inertia_coeff, sums)
 
     def _water_yaw_rate(self, areas: np.ndarray, water, yaw_cs: tuple,
                         sums: StripSums) -> float:
@@ -477,7 +491,7 @@ class SimCore:
         if not self.params.wave_moments.strip_moments or self.world.calm:
             return 0.0
         return water_yaw_rate_rps(areas, water, self.hull.station_x_m, self.hull.station_y_m,
-                                  yaw_cs, sums)
+                                  yaw_cs, self._surge_to_sway_drag, sums)
 
     def _water_over_tracks(self) -> np.ndarray:
         """Height of the surface over the sand at the strips along the tracks' contact, m."""

@@ -69,9 +69,10 @@ def sum_wrenches(terms: list[Wrench]) -> BodyForces:
 class StripSums(NamedTuple):
     """Sums over the hull strips weighted by their immersed section areas a_i (m^2): of 1 and
     of the water's velocity (vx, vy) and acceleration (ax, ay) at the strips (odom), each
-    also times the strips' body x_i, y_i and x_i^2 + y_i^2. The buoyancy, the wave forces,
-    their moments and the water's yaw rate are all linear in these: one matrix product per
-    step (``strip_sums``) gives them all (the r2_ kinematic sums come with it, unused)."""
+    also times the strips' body x_i, y_i, x_i^2 and y_i^2. The buoyancy, the wave forces,
+    their moments (each direction with its own inertia coefficient) and the water's yaw rate
+    (each direction weighted by its drag) are all linear in these: one matrix product per
+    step (``strip_sums``) gives them all (the x2_, y2_ kinematic sums come with it, unused)."""
 
     area_m2: float
     vx: float
@@ -88,18 +89,23 @@ class StripSums(NamedTuple):
     y_vy: float
     y_ax: float
     y_ay: float
-    area_r2_m4: float
-    r2_vx: float
-    r2_vy: float
-    r2_ax: float
-    r2_ay: float
+    area_x2_m4: float
+    x2_vx: float
+    x2_vy: float
+    x2_ax: float
+    x2_ay: float
+    area_y2_m4: float
+    y2_vx: float
+    y2_vy: float
+    y2_ax: float
+    y2_ay: float
 
 
 def strip_basis(station_x_m: np.ndarray, station_y_m: np.ndarray) -> np.ndarray:
-    """The strips' (4, N) rows 1, x, y, x^2 + y^2 that ``strip_sums`` weights (keep it)."""
+    """The strips' (5, N) rows 1, x, y, x^2, y^2 that ``strip_sums`` weights (keep it)."""
     x = np.asarray(station_x_m, dtype=float)
     y = np.asarray(station_y_m, dtype=float)
-    return np.ascontiguousarray(np.vstack([np.ones_like(x), x, y, x * x + y * y]))
+    return np.ascontiguousarray(np.vstack([np.ones_like(x), x, y, x * x, y * y]))
 
 
 def strip_sums(areas_m2: np.ndarray, water: WaterSample, basis: np.ndarray) -> StripSums:
@@ -176,57 +182,77 @@ def wave_forcing(calm: bool, areas_m2: np.ndarray, strip_length_m: float, water:
 
 
 def water_yaw_rate_rps(areas_m2: np.ndarray, water: WaterSample, station_x_m: np.ndarray,
-                       station_y_m: np.ndarray, yaw_cs: tuple,
+                       station_y_m: np.ndarray, yaw_cs: tuple, surge_to_sway_drag: float = 1.0,
                        sums: StripSums | None = None) -> float:
-    """The water's own yaw rate over the hull: the least-squares rotation of the wave particle
-    velocity at the immersed strips (body axes, immersed area as weight), rad/s.
+    """The water's own yaw rate over the hull: the rotation of the wave particle velocity at
+    the immersed strips that the hull's drag acts against (body axes), rad/s.
 
     The hull drag acts on the velocity relative to the water, strip by strip; in a
     short-crested sea the transverse water velocity differs along the hulls (and the surge
     velocity between them), so the yaw damping acts on r minus this rate, as the surge and sway
-    drag act on u and v minus the water's mean velocity (``wave_forcing``). ``sums``: the
-    strips' ``strip_sums`` if the caller has them."""
+    drag act on u and v minus the water's mean velocity (``wave_forcing``). Each strip's
+    relative velocity is weighted by the drag it meets in that direction: the transverse
+    (cross-flow) one by the sway drag, the longitudinal one by ``surge_to_sway_drag`` times
+    it (1: the least-squares rotation, immersed area as weight). ``sums``: the strips'
+    ``strip_sums`` if the caller has them."""
     sums = _sums_of(sums, areas_m2, water, station_x_m, station_y_m)
-    weight = sums.area_r2_m4
+    w = surge_to_sway_drag
+    weight = sums.area_x2_m4 + w * sums.area_y2_m4          # sum of a (x^2 + w y^2)
     if weight <= 1e-12:
         return 0.0
     c, s = yaw_cs
-    # sum of a (x vb - y ub), with body-axes water velocity ub = c vx + s vy, vb = -s vx + c vy
-    return (c * (sums.x_vy - sums.y_vx) - s * (sums.x_vx + sums.y_vy)) / weight
+    # sum of a (x vb - w y ub), with body-axes water velocity ub = c vx + s vy, vb = -s vx + c vy
+    return (c * (sums.x_vy - w * sums.y_vx) - s * (sums.x_vx + w * sums.y_vy)) / weight
 
 
 class WaveMoments(NamedTuple):
     """Moments about the centre of gravity of the strips' wave forces: yaw (odom z), roll and
-    pitch (body x, y), N m."""
+    pitch (body x, y), N m; and the strips' transverse force beyond the total force of
+    ``wave_forcing`` (which takes the surge inertia coefficient in every direction), odom, N."""
 
     yaw_nm: float
     roll_nm: float
     pitch_nm: float
+    extra_fx_n: float = 0.0
+    extra_fy_n: float = 0.0
 
 
 def wave_moments(calm: bool, areas_m2: np.ndarray, strip_length_m: float, water: WaterSample,
                  waves: WaveParams, rho_kgpm3: float, station_x_m: np.ndarray,
                  station_y_m: np.ndarray, yaw_cs: tuple, lever_z_m: float,
+                 sway_inertia_coeff: float | None = None,
                  sums: StripSums | None = None) -> WaveMoments:
-    """Each strip's Froude-Krylov + diffraction force C_m rho V a (as ``wave_forcing``)
-    acting at the strip: its horizontal offset from the centre of gravity gives the yaw
-    moment, its height ``lever_z_m`` relative to it (< 0: below) the roll and pitch moments.
-    In a short-crested sea the transverse acceleration differs along the hulls, so the yaw
-    moment does not vanish with the vehicle's symmetry. ``sums``: the strips' ``strip_sums``
-    if the caller has them."""
+    """Each strip's Froude-Krylov + diffraction force acting at the strip: its horizontal
+    offset from the centre of gravity gives the yaw moment, its height ``lever_z_m`` relative
+    to it (< 0: below) the roll and pitch moments. In a short-crested sea the transverse
+    acceleration differs along the hulls, so the yaw moment does not vanish with the vehicle's
+    symmetry.
+
+    Morison's inertia force per strip is C_m rho V a with C_m = 1 + C_a in each direction:
+    along the hulls C_m = ``waves.surge_inertia_coeff`` (1 + the surge added-mass ratio),
+    across them ``sway_inertia_coeff`` (1 + the sway added-mass ratio: the added mass the
+    body's sway inertia carries is the same that the accelerating water exerts; None: the
+    surge one). The transverse force beyond the surge coefficient's is returned (odom) for
+    the total force. ``sums``: the strips' ``strip_sums`` if the caller has them."""
     if calm:
         return WaveMoments(0.0, 0.0, 0.0)
     sums = _sums_of(sums, areas_m2, water, station_x_m, station_y_m)
     c, s = yaw_cs
-    cm_l = waves.surge_inertia_coeff * rho_kgpm3 * strip_length_m
-    # strip forces f = C_m rho l a (ax, ay) in odom at the odom offsets (c x - s y, s x + c y)
-    yaw = cm_l * (c * (sums.x_ay - sums.y_ax) - s * (sums.y_ay + sums.x_ax))
-    fx_sum, fy_sum = cm_l * sums.ax, cm_l * sums.ay
-    fx_body = c * fx_sum + s * fy_sum
-    fy_body = -s * fx_sum + c * fy_sum
+    rho_l = rho_kgpm3 * strip_length_m
+    cm_x = waves.surge_inertia_coeff
+    cm_y = cm_x if sway_inertia_coeff is None else sway_inertia_coeff
+    # the strips' body-axes accelerations, area-weighted: along = c ax + s ay, across =
+    # -s ax + c ay; the force along is cm_x rho l along, across cm_y rho l across; the yaw
+    # moment sum of x f_across - y f_along (the cross product is the same in body axes)
+    across = -s * sums.ax + c * sums.ay
+    fx_body = cm_x * rho_l * (c * sums.ax + s * sums.ay)
+    fy_body = cm_y * rho_l * across
+    yaw = rho_l * (cm_y * (c * sums.x_ay - s * sums.x_ax)
+                   - cm_x * (c * sums.y_ax + s * sums.y_ay))
+    extra = (cm_y - cm_x) * rho_l * across
     # REP 103: a force to port below the centre of gravity lifts the port side (+ roll); a
     # force forward below it lifts the bow (- pitch)
-    return WaveMoments(yaw, -lever_z_m * fy_body, lever_z_m * fx_body)
+    return WaveMoments(yaw, -lever_z_m * fy_body, lever_z_m * fx_body, -s * extra, c * extra)
 
 
 def track_wetness(water_over_ground_m: np.ndarray, track_height_m: float) -> float:

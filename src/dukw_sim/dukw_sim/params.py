@@ -166,6 +166,11 @@ class WaveMomentParams:
     strip_moments: bool                  # false: only the total wave force (no moments)
     transverse_force_z_m: float          # height of the strips' transverse force above the
                                          # keel (the hulls' centre of buoyancy), m
+    sway_inertia_from_added_mass: bool   # the strips' transverse Morison C_m is 1 + the
+                                         # sway added-mass ratio (false: the surge C_m)
+    water_rotation_by_drag: bool         # the water's rotation the yaw damping acts against
+                                         # weights cross-flow by the sway drag, along-hull
+                                         # flow by the surge drag (false: equally)
 
 
 @dataclass(frozen=True)

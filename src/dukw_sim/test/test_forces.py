@@ -121,7 +121,35 @@ def test_a_uniform_transverse_wave_gives_no_yaw_and_a_gradient_does():
     mass_per_strip = PARAMS.waves.surge_inertia_coeff * 1025.0 * 0.05 * 0.3
     assert twist.yaw_nm == pytest.approx(mass_per_strip * 0.5 * 4.0)
     assert wave_moments(True, AREAS_M2, 0.3, _water(np.zeros(6), 0.5 * STATION_X_M),
-                        *args[1:]) == (0.0, 0.0, 0.0)
+                        *args[1:]) == (0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+def test_the_sway_inertia_coefficient_scales_the_transverse_force_only():
+    """Morison's C_m = 1 + C_a across the hulls: the transverse moments and the force beyond
+    the total's surge C_m grow with it, the surge ones do not; at any heading."""
+    yaw = 0.7
+    cs = (math.cos(yaw), math.sin(yaw))
+    args = (PARAMS.waves, 1025.0, STATION_X_M, STATION_Y_M, cs, -0.11)
+    cm_x = PARAMS.waves.surge_inertia_coeff
+    # water accelerating across the hull (body y) with a gradient along it
+    across = 0.5 * STATION_X_M + 0.2
+    water = _water(-math.sin(yaw) * across, math.cos(yaw) * across)
+    same = wave_moments(False, AREAS_M2, 0.3, water, *args)
+    assert (same.extra_fx_n, same.extra_fy_n) == (0.0, 0.0)
+    assert wave_moments(False, AREAS_M2, 0.3, water, *args, cm_x) == same
+    cm_y = 1.9
+    more = wave_moments(False, AREAS_M2, 0.3, water, *args, cm_y)
+    assert more.yaw_nm == pytest.approx(same.yaw_nm * cm_y / cm_x)
+    assert more.roll_nm == pytest.approx(same.roll_nm * cm_y / cm_x)
+    extra_n = (cm_y - cm_x) * 1025.0 * 0.05 * 0.3 * float(across.sum())
+    assert more.extra_fx_n == pytest.approx(-math.sin(yaw) * extra_n)
+    assert more.extra_fy_n == pytest.approx(math.cos(yaw) * extra_n)
+    # water accelerating along the hull: nothing changes
+    along = _water(math.cos(yaw) * np.full(6, 0.5), math.sin(yaw) * np.full(6, 0.5))
+    base = wave_moments(False, AREAS_M2, 0.3, along, *args)
+    surge = wave_moments(False, AREAS_M2, 0.3, along, *args, cm_y)
+    assert surge.pitch_nm == pytest.approx(base.pitch_nm) and surge.pitch_nm != 0.0
+    assert surge.extra_fy_n == pytest.approx(0.0, abs=1e-9)
 
 
 def test_a_surge_wave_force_below_the_centre_of_gravity_lifts_the_bow():
@@ -200,6 +228,31 @@ def test_water_yaw_rate_is_the_rotation_of_the_water_over_the_immersed_hull(yaw_
     assert water_yaw_rate_rps(np.zeros(6), water, xs, ys, (c, s)) == 0.0
 
 
+@pytest.mark.parametrize('yaw_rad', [0.0, 2.5])
+def test_the_water_rotation_weights_each_strips_flow_by_its_drag(yaw_rad):
+    """The hulls' drag acts on the cross-flow (sway drag) more than on the along-hull flow
+    (surge drag): in an irrotational strain (v = S x, u = S y) the cross-flow turns the hull
+    by S, the along-hull flow by -S; weighted equally they give (x^2 - y^2) / (x^2 + y^2) S,
+    by the drags' ratio w (x^2 - w y^2) / (x^2 + w y^2) S. A solid-body rotation stays
+    what it is at any weighting."""
+    xs = np.array([-1.0, 0.0, 1.0, -1.0, 0.0, 1.0])
+    ys = np.array([0.4, 0.4, 0.4, -0.4, -0.4, -0.4])
+    c, s = math.cos(yaw_rad), math.sin(yaw_rad)
+    areas = np.full(6, 0.05)
+    strain = 0.2
+    ub, vb = strain * ys, strain * xs                    # body axes
+    water = _flow(c * ub - s * vb, s * ub + c * vb)
+    x2, y2 = float(np.sum(xs ** 2)), float(np.sum(ys ** 2))
+    for w in (1.0, 0.1, 0.0):
+        expected = strain * (x2 - w * y2) / (x2 + w * y2)
+        assert water_yaw_rate_rps(areas, water, xs, ys, (c, s), surge_to_sway_drag=w) \
+            == pytest.approx(expected, rel=1e-12)
+    ox, oy = c * xs - s * ys, s * xs + c * ys
+    spin = _flow(-0.2 * oy, 0.2 * ox)
+    assert water_yaw_rate_rps(areas, spin, xs, ys, (c, s), surge_to_sway_drag=0.1) \
+        == pytest.approx(0.2, rel=1e-12)
+
+
 def test_strip_sums_are_the_area_weighted_sums_strip_by_strip():
     """The one matrix product the wave forces, moments and water yaw rate read."""
     rng = np.random.default_rng(2)
@@ -207,17 +260,45 @@ def test_strip_sums_are_the_area_weighted_sums_strip_by_strip():
     kin = rng.normal(size=(4, 9))          # more points than strips: the strips come first
     water = WaterSample(np.zeros(9), *kin)
     sums = strip_sums(areas, water, strip_basis(xs, ys))
-    for weight, prefix in ((1.0, ''), (xs, 'x_'), (ys, 'y_'), (xs ** 2 + ys ** 2, 'r2_')):
+    weights = ((1.0, ''), (xs, 'x_'), (ys, 'y_'), (xs ** 2, 'x2_'), (ys ** 2, 'y2_'))
+    for weight, prefix in weights:
         for row, name in zip(kin, ('vx', 'vy', 'ax', 'ay'), strict=True):
             want = math.fsum(areas * weight * row[:6])
             assert getattr(sums, prefix + name) == pytest.approx(want, rel=1e-13, abs=1e-15)
     assert sums.area_m2 == pytest.approx(math.fsum(areas), rel=1e-14)
     assert sums.area_x_m3 == pytest.approx(math.fsum(areas * xs), rel=1e-13)
     assert sums.area_y_m3 == pytest.approx(math.fsum(areas * ys), rel=1e-13)
-    assert sums.area_r2_m4 == pytest.approx(math.fsum(areas * (xs ** 2 + ys ** 2)), rel=1e-13)
-    # the functions give the same with the caller's sums as with their own
+    assert sums.area_x2_m4 == pytest.approx(math.fsum(areas * xs ** 2), rel=1e-13)
+    assert sums.area_y2_m4 == pytest.approx(math.fsum(areas * ys ** 2), rel=1e-13)
+    # the functions give the same with the caller's sums as with their own, with the drag
+    # weighting and the sway inertia coefficient too
     c, s = math.cos(0.7), math.sin(0.7)
-    assert water_yaw_rate_rps(areas, water, xs, ys, (c, s), sums) == \
-        water_yaw_rate_rps(areas, water, xs, ys, (c, s))
+    for drag_ratio in (1.0, 0.1):
+        assert water_yaw_rate_rps(areas, water, xs, ys, (c, s), drag_ratio, sums) == \
+            water_yaw_rate_rps(areas, water, xs, ys, (c, s), drag_ratio)
     args = (False, areas, 0.3, water, PARAMS.waves, 1025.0, xs, ys, (c, s), -0.2)
-    assert wave_moments(*args, sums) == wave_moments(*args)
+    for sway_cm in (None, 1.9):
+        assert wave_moments(*args, sway_cm, sums) == wave_moments(*args, sway_cm)
+
+
+def test_the_wave_moments_from_the_sums_are_the_strips_morison_forces():
+    """Strip by strip: C_m rho V a along the hull with the surge C_m, across it with the sway
+    C_m, at each strip's odom offset; the yaw moment, the body-axes totals (roll, pitch) and
+    the transverse force beyond the surge C_m's from the sums are the same."""
+    rng = np.random.default_rng(5)
+    xs, ys, areas = rng.uniform(-1, 1, 6), rng.uniform(-0.5, 0.5, 6), rng.uniform(0, 0.06, 6)
+    water = WaterSample(np.zeros(6), *rng.normal(size=(4, 6)))
+    c, s = math.cos(2.1), math.sin(2.1)
+    cm_x, cm_y, lever = PARAMS.waves.surge_inertia_coeff, 1.9, -0.2
+    rho_v = 1025.0 * areas * 0.3
+    ax, ay = water.accel_x_mps2, water.accel_y_mps2
+    f_along, f_across = cm_x * rho_v * (c * ax + s * ay), cm_y * rho_v * (-s * ax + c * ay)
+    fx, fy = c * f_along - s * f_across, s * f_along + c * f_across       # odom
+    yaw = math.fsum((c * xs - s * ys) * fy - (s * xs + c * ys) * fx)
+    extra = math.fsum((cm_y - cm_x) / cm_y * f_across)
+    got = wave_moments(False, areas, 0.3, water, PARAMS.waves, 1025.0, xs, ys, (c, s), lever,
+                       cm_y)
+    assert got.yaw_nm == pytest.approx(yaw, rel=1e-12)
+    assert got.roll_nm == pytest.approx(-lever * math.fsum(f_across), rel=1e-12)
+    assert got.pitch_nm == pytest.approx(lever * math.fsum(f_along), rel=1e-12)
+    assert (got.extra_fx_n, got.extra_fy_n) == pytest.approx((-s * extra, c * extra), rel=1e-12)
