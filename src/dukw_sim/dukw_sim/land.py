@@ -91,19 +91,24 @@ def _compliant_speeds(patch: traction.TrackPatch, strength: float, ref: list, gr
         h0, h1 = f0 + o0 - k0 * (r0 - v0), f1 + o1 - k1 * (r1 - v1)
         if abs(h0) < _COMPLIANCE_TOL_N and abs(h1) < _COMPLIANCE_TOL_N:
             return [v0, v1], [f0, f1]
-        if h0 > 0.0:
-            hi0 = v0
-        else:
-            lo0 = v0
-        step = v0 - h0 / ((force(patch, v0 + _PROBE_MPS, g0) - f0) / _PROBE_MPS + k0)
-        v0 = step if lo0 < step < hi0 else 0.5 * (lo0 + hi0)
-        if h1 > 0.0:
-            hi1 = v1
-        else:
-            lo1 = v1
-        step = v1 - h1 / ((force(patch, v1 + _PROBE_MPS, g1) - f1) / _PROBE_MPS + k1)
-        v1 = step if lo1 < step < hi1 else 0.5 * (lo1 + hi1)
+        v0, lo0, hi0 = _newton_in_bracket(patch, v0, g0, f0, h0, k0, lo0, hi0)
+        v1, lo1, hi1 = _newton_in_bracket(patch, v1, g1, f1, h1, k1, lo1, hi1)
     return [v0, v1], None
+
+
+def _newton_in_bracket(patch: traction.TrackPatch, v: float, ground: float, f: float,
+                       residual: float, stiffness: float, lo: float,
+                       hi: float) -> tuple[float, float, float]:
+    """One track's next compliant speed: the bracket narrowed by the residual's sign, then a
+    Newton step (numerical soil derivative plus the loop's stiffness), or the bisection when
+    the step leaves the bracket. Returns (speed, lo, hi)."""
+    if residual > 0.0:
+        hi = v
+    else:
+        lo = v
+    slope = (traction.track_force_f(patch, v + _PROBE_MPS, ground) - f) / _PROBE_MPS
+    step = v - residual / (slope + stiffness)
+    return (step if lo < step < hi else 0.5 * (lo + hi)), lo, hi
 
 
 def _derivatives(patch: traction.TrackPatch, speed: float, ground: float, f0: float,
