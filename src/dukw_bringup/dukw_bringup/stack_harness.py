@@ -265,8 +265,9 @@ class Stack:
 
     def _mode(self, t_ns: int, publication: ModePublication) -> None:
         decision = publication.decision
-        if publication.changed:
-            self.record.modes.append((t_ns * 1e-9, decision.mode, decision.reason))
+        modes = self.record.modes
+        if publication.changed and (not modes or modes[-1][1] != decision.mode):
+            modes.append((t_ns * 1e-9, decision.mode, decision.reason))   # changes of mode
         self.publish('drive_mode', t_ns, decision)
 
     def _record(self, truth: Truth) -> None:

@@ -325,3 +325,18 @@ def test_a_missions_return_to_land_is_timed_from_its_time_at_sea():
     assert campaign._mode_delays(t, medium, modes, returns=True) == pytest.approx((0.5, 0.8))
     to_water, to_land = campaign._mode_delays(t, medium, modes)
     assert to_water == pytest.approx(0.5) and math.isnan(to_land)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize('index', [3, 7])
+def test_the_main_jobs_mission_climbs_out_of_the_swash(index):
+    """config/campaigns/main_job.yaml: the main job's mission, beach, soil and 28 cm sea.
+    Runs 3 and 7 stalled in the swash at x 1.1 / 2.8 m (10 of 20 did) until the tow-test
+    bound covered the whole pull and LAND kept the props there; now the mission is done."""
+    from dukw_common.config import default_config_path
+    path = default_config_path().parent / 'campaigns' / 'main_job.yaml'
+    row = campaign.run_one(campaign.load_spec(str(path)), index)
+    assert not row['error']
+    assert row['mission_done'], f"stuck at x = {row['end_x_m']:.2f} m"
+    assert row['mission_time_s'] < 150.0
+    assert row['time_over_limit_s'] < 30.0

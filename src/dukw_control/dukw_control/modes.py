@@ -55,6 +55,8 @@ NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
     ('transition_track_weight', 'share of the request to the tracks in the transition',
      0.0, 1.0),
     ('transition_prop_weight', 'share of the request to the props in the transition', 0.0, 1.0),
+    ('land_prop_hold_s', 'on land the props keep the transition share this long after a '
+     'water sensor last read wet, s', 0.0, 60.0),
     ('water_tracks_idle', 'afloat: tracks idle (true) or off (false)', None, None),
     ('water_contact_timeout_s', 'older water/contact: safe stop, s', 0.01, 60.0),
     ('traction_timeout_s', 'older traction: safe stop, s', 0.01, 60.0),
@@ -90,6 +92,7 @@ class ModeSettings:
     min_dwell_s: float                # a mode is kept at least this long
     transition_track_weight: float
     transition_prop_weight: float
+    land_prop_hold_s: float           # LAND keeps the props this long after the last wet read
     water_tracks_idle: bool           # afloat: tracks idle (True) or off (False)
     water_contact_timeout_s: float    # inputs older than these are stale
     traction_timeout_s: float
@@ -106,6 +109,8 @@ class ModeSettings:
             raise ValueError('water_enter_fraction must be below water_exit_fraction')
         if not self.transition_enter_fraction < self.land_enter_fraction:
             raise ValueError('transition_enter_fraction must be below land_enter_fraction')
+        if not self.land_prop_hold_s >= 0.0:
+            raise ValueError('land_prop_hold_s must be >= 0')
         if not self.friction_force_n < self.ground_force_n:
             raise ValueError('friction_force_n must be below ground_force_n')
         for name in ('transition_track_weight', 'transition_prop_weight'):
@@ -153,6 +158,8 @@ class ModeManager:
         self.s = settings
         self._stamps: dict[str, float] = {}
         self.fore_wet = self.aft_wet = False
+        self.last_wet_s = -math.inf      # a water sensor last read wet (the props' hold)
+        self.props_in_swash = False      # LAND, yet the props still push (land_prop_hold_s)
         self.depth_valid = False
         self.weight_fraction = 1.0
         self.track_force_n = 0.0         # low-passed max of |port|, |stbd|
@@ -171,6 +178,8 @@ class ModeManager:
     def on_water_contact(self, fore_wet: bool, aft_wet: bool, now_s: float) -> None:
         """Debounced fore/aft wet flags from the water-contact sensors."""
         self.fore_wet, self.aft_wet = bool(fore_wet), bool(aft_wet)
+        if self.fore_wet or self.aft_wet:
+            self.last_wet_s = now_s
         self._stamps['water/contact'] = now_s
 
     def on_depth(self, valid: bool, depth_m: float, now_s: float) -> None:
@@ -312,7 +321,18 @@ class ModeManager:
             refusal = self.refusal(self._forced, now_s)
             if refusal:
                 self.release(now_s, f'forcing dropped ({refusal}); ')
+        self._update_swash(now_s)
         return self.decision()
+
+    def _update_swash(self, now_s: float) -> None:
+        """On land in the swash the propellers, which hang below the water sensors (their
+        discs reach 2.5 cm over the keel, the sensors sit 0.30 m up), still bite between
+        the run-ups that wet the sensors: LAND keeps them pushing for land_prop_hold_s after
+        the last wet reading, so a LAND <-> TRANSITION flip in the swash costs no thrust."""
+        swash = self._mode == Mode.LAND and now_s - self.last_wet_s < self.s.land_prop_hold_s
+        if swash != self.props_in_swash:
+            self.props_in_swash = swash
+            self.changed = True
 
     def _decide(self, now_s: float) -> None:
         stale = self.stale_inputs(now_s)
@@ -356,9 +376,13 @@ class ModeManager:
     def decision(self) -> ModeDecision:
         """The current decision with its actuator weights."""
         s = self.s
-        weights = {Mode.LAND: (1.0, 0.0, False),
+        land_props = s.transition_prop_weight if self.props_in_swash else 0.0
+        weights = {Mode.LAND: (1.0, land_props, False),
                    Mode.TRANSITION: (s.transition_track_weight, s.transition_prop_weight, False),
                    Mode.WATER: (0.0, 1.0, s.water_tracks_idle),
                    Mode.SAFE_STOP: (0.0, 0.0, False)}
         track_w, prop_w, idle = weights[self._mode]
-        return ModeDecision(self._mode, self.automatic, track_w, prop_w, idle, self._reason)
+        reason = self._reason
+        if self.props_in_swash:
+            reason += f'; props on in the swash (wet within {s.land_prop_hold_s:g} s)'
+        return ModeDecision(self._mode, self.automatic, track_w, prop_w, idle, reason)

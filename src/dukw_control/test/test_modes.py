@@ -156,3 +156,37 @@ def test_inconsistent_thresholds_are_refused(mode_settings):
         dataclasses.replace(mode_settings, water_enter_fraction=0.5, water_exit_fraction=0.4)
     with pytest.raises(ValueError):
         ModeSettings(**{**dataclasses.asdict(mode_settings), 'transition_prop_weight': 2.0})
+
+
+def test_on_land_in_the_swash_the_props_keep_pushing_until_the_sensors_stay_dry(mode_settings):
+    # the props hang below the water sensors: between run-ups that wet the sensors they
+    # still bite, so LAND keeps them for land_prop_hold_s after the last wet reading
+    hold_s = mode_settings.land_prop_hold_s
+    assert hold_s > 1.0
+    f = Feed(mode_settings)
+    f.run(2.0, fraction=0.6, fore=True, aft=True, force_n=300.0)     # grounding: TRANSITION
+    f.run(3.0, fraction=0.9, aft=True, force_n=300.0)
+    d = f.run(1.0, fraction=1.0, force_n=300.0)                      # sensors dry: LAND
+    assert d.mode == Mode.LAND and d.track_weight == 1.0
+    assert d.prop_weight == mode_settings.transition_prop_weight and 'swash' in d.reason
+    assert f.mm.changed                                  # published at once, not at republish
+    f.mm.changed = False
+    d = f.run(hold_s - 1.5, fraction=1.0, force_n=300.0)
+    assert d.prop_weight > 0.0
+    d = f.run(1.0, fraction=1.0, force_n=300.0)                      # dry for hold_s: off
+    assert d.mode == Mode.LAND and d.prop_weight == 0.0 and 'swash' not in d.reason
+    assert f.mm.changed
+    d = f.run(0.2, fraction=1.0, aft=True, force_n=300.0)            # a run-up wets it again
+    assert d.prop_weight > 0.0
+    assert [m for m, *_ in f.modes] == [Mode.TRANSITION, Mode.LAND]
+
+
+def test_dry_land_never_runs_the_props(mode_settings):
+    f = Feed(mode_settings)
+    for _ in range(40):
+        assert f.run(0.5).prop_weight == 0.0
+
+
+def test_a_negative_swash_hold_is_refused(mode_settings):
+    with pytest.raises(ValueError, match='land_prop_hold_s'):
+        ModeSettings(**{**dataclasses.asdict(mode_settings), 'land_prop_hold_s': -1.0})

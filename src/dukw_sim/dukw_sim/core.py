@@ -519,17 +519,27 @@ class SimCore:
         if w_eff > 0.0:
             terms += rolling_resistance(w_eff, drives.ground, land, half)
             terms += lateral_resistance(w_eff, self.v, self.r, self._lat_s, land, self._weight)
-            terms += slope_gravity(self._weight, imm.buoyancy_n,
-                                   self.world.beach.gradient(self.x), c, s)
+            gravity = slope_gravity(self._weight, imm.buoyancy_n,
+                                    self.world.beach.gradient(self.x), c, s)
+            terms += gravity
             if self.params.surf.wet_motion_resistance_coeff > 0.0:
                 terms += surf_resistance(w_eff, self._track_wetness(), self._wave_height_m,
-                                         drives.ground, self.params.surf, half)
+                                         drives.ground, self.params.surf, half,
+                                         self._other_pull_n(w_eff, gravity))
         terms += propulsion(thrust, wat.prop_walk_ratio, self.params.propeller.x_m, half)
         terms.append(hydrodynamic_drag(*rel_water, imm.fraction, wat))
         ex, ey, en = self._external
         terms.append(odom_force(waves.fx_n + ex, waves.fy_n + ey,
                                 en + wave_yaw_nm if wave_yaw_nm else en, c, s))
         return sum_wrenches(terms)
+
+    def _other_pull_n(self, w_eff: float, gravity: list) -> float:
+        """What a tow line's load cell adds to the wet sand's resistance while pulling the
+        vehicle the way it moves: the rolling resistance and the slope's gravity against the
+        motion (surf.max_resistance_n bounds the sum), N."""
+        along_n = gravity[0].x_n if gravity else 0.0
+        direction = math.tanh(self.u / 0.05) if self.u else 1.0
+        return self.params.land.rolling_resistance_coeff * w_eff + max(-along_n * direction, 0.0)
 
     def _integrate_plane(self, forces: BodyForces, drives: _Drives, frac: float,
                          yaw_cs: tuple) -> TrackState:

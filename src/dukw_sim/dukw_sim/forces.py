@@ -273,14 +273,17 @@ def saturated_share(water_over_ground_m: np.ndarray) -> float:
 
 
 def surf_resistance(w_eff_n: float, wetness: float, wave_height_m: float, ground_mps: tuple,
-                    surf: SurfParams, half_sep_m: float) -> list[Wrench]:
+                    surf: SurfParams, half_sep_m: float, other_pull_n: float = 0.0
+                    ) -> list[Wrench]:
     """Motion resistance of the sand the surf's waves liquefy (sinkage and bulldozing): a
     Coulomb resistance growing with the weight on the tracks, with the share of the tracks
     under water and with the waves' height (the depth of the wave-induced liquefaction grows
-    with the wave's pressure on the bed), bounded by the tow tests' largest resistance."""
+    with the wave's pressure on the bed). The tow tests' load cell measured the whole pull
+    (this, the rolling resistance and the slope's gravity against the motion:
+    ``other_pull_n``) up to ``surf.max_resistance_n``; that bounds the sum."""
     liquefied = wave_height_m / surf.reference_wave_height_m
     total_n = min(surf.wet_motion_resistance_coeff * liquefied * wetness * w_eff_n,
-                  surf.max_resistance_n)
+                  surf.max_resistance_n - other_pull_n)
     if total_n <= 0.0:
         return []
     return _coulomb_per_track(total_n / 2.0, ground_mps, half_sep_m)

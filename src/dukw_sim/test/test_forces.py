@@ -187,6 +187,13 @@ def test_surf_resistance_grows_with_wetness_weight_and_waves_within_the_tow_test
     heavy = dataclasses.replace(surf, wet_motion_resistance_coeff=1.0)
     capped = total(surf_resistance(2894.0, 1.0, h, (0.5, 0.5), heavy, HALF_SEP_M), 'x_n')
     assert capped == pytest.approx(-surf.max_resistance_n, rel=1e-6)
+    # the tow line's load cell measured the whole pull: with 300 N of rolling resistance and
+    # slope against the motion the wet sand adds at most the rest of the bound
+    shared = total(surf_resistance(2894.0, 1.0, h, (0.5, 0.5), heavy, HALF_SEP_M, 300.0),
+                   'x_n')
+    assert shared == pytest.approx(-(surf.max_resistance_n - 300.0), rel=1e-6)
+    assert surf_resistance(2894.0, 1.0, h, (0.5, 0.5), heavy, HALF_SEP_M,
+                           surf.max_resistance_n + 1.0) == []
 
 
 def test_mooring_pulls_back_to_the_anchor_and_turns_about_its_point():
