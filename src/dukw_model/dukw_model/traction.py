@@ -166,6 +166,9 @@ def effective_weight_n(displacement_n: float, submerged_volume_m3: ArrayLike,
                        slope_rad: ArrayLike, water_density_kgpm3: float,
                        gravity_mps2: float) -> ArrayLike:
     """W_e = (Delta - rho g V) cos(theta), never negative (afloat gives 0), N."""
+    if is_scalar(submerged_volume_m3) and is_scalar(slope_rad):     # scalar path, same bits
+        buoyancy_n = water_density_kgpm3 * gravity_mps2 * float(submerged_volume_m3)
+        return max(displacement_n - buoyancy_n, 0.0) * _cos(float(slope_rad))
     buoyancy = water_density_kgpm3 * gravity_mps2 * np.asarray(submerged_volume_m3, dtype=float)
     out = np.maximum(displacement_n - buoyancy, 0.0) * np.cos(slope_rad)
     return float(out) if np.ndim(out) == 0 else out
@@ -224,6 +227,18 @@ class TrackPatch:
 
 
 _TAN_OF: dict[float, float] = {}
+_COS_OF: dict[float, float] = {}
+
+
+def _cos(angle_rad: float) -> float:
+    """float(np.cos(angle)), remembered per angle (numpy's cos is not libm's; the slopes the
+    callers ask for are few)."""
+    cos_angle = _COS_OF.get(angle_rad)
+    if cos_angle is None:
+        if len(_COS_OF) > 1024:
+            _COS_OF.clear()
+        cos_angle = _COS_OF[angle_rad] = float(np.cos(angle_rad))
+    return cos_angle
 
 
 def _tan(phi_rad: float) -> float:

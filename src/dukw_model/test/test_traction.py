@@ -53,6 +53,19 @@ def test_no_weight_no_traction():
     assert traction.tractive_force_n(0.5, 0.0, SOIL, A, L) == 0.0
 
 
+def test_effective_weight_scalar_path_gives_the_array_path_bits():
+    """The scalar path (the simulator's every step on the sand) equals the array path to
+    the bit, zero weight afloat included."""
+    rng = np.random.default_rng(5)
+    volumes = np.concatenate([rng.uniform(0.0, 0.4, 200), [0.0, 0.2835, 0.5]])
+    slopes = np.concatenate([rng.uniform(0.0, 0.4, 200), [0.0, 0.0785, 0.0785]])
+    want = traction.effective_weight_n(2894.0, volumes, slopes, 1025.0, 9.80665)
+    got = [traction.effective_weight_n(2894.0, v, a, 1025.0, 9.80665)
+           for v, a in zip(volumes.tolist(), slopes.tolist(), strict=True)]
+    assert _bits(got) == _bits(want)
+    assert got[-1] == 0.0 and got[-3] > 0.0
+
+
 def test_effective_weight_goes_to_zero_afloat_and_scales_with_cos_slope():
     assert traction.effective_weight_n(2894.0, 0.0, 0.0, 1025, 9.81) == 2894.0
     assert traction.effective_weight_n(2894.0, 0.0, math.radians(11), 1025, 9.81) == \
