@@ -154,6 +154,21 @@ def linearise(contact: TrackContact | None, ref_mps: tuple, ground_mps: tuple,
                             _series_slope(d_t[1], d_g[1], stiff[1], soft[1])], list(speed))
 
 
+def predicted_speeds(lin: TrackLinear, stiffness_n_per_mps: tuple, ground_from_mps: tuple,
+                     ground_to_mps: tuple) -> tuple:
+    """The loaded tracks' speeds at the ground speeds ``ground_to_mps``, to first order from
+    ``lin`` (linearised at ``ground_from_mps``): along a soft loop's equilibrium
+    dv/dg = -(series dF/dg) / k = -D_g / (k + D_t); a stiff loop's track keeps its speed.
+    The Newton start of the next linearisation."""
+    out = []
+    for i in (0, 1):
+        k, speed = stiffness_n_per_mps[i], lin.speed_mps[i]
+        if math.isfinite(k):
+            speed -= lin.dforce_dground[i] / k * (ground_to_mps[i] - ground_from_mps[i])
+        out.append(speed)
+    return tuple(out)
+
+
 def motor_limited_speed(contact: TrackContact | None, ref_mps: float, ground_mps: float,
                         soil_force_n: float) -> float:
     """Track speed between the ground speed and the reference where the soil takes
