@@ -175,10 +175,11 @@ def effective_weight_n(displacement_n: float, submerged_volume_m3: ArrayLike,
 
 
 # ------------------------------------------------------------------ float paths (hot callers)
-# The simulator solves each track's speed loop against the soil with a few dozen force
-# evaluations per step: these take plain floats and a patch with its constants worked out
-# once, and give the same bits as ``slip`` and ``track_force_n`` (same operations in the same
-# order; expm1 is numpy's, whose vectorised routine is not libm's).
+# The simulator solves each track's speed loop against the soil with a few force evaluations
+# (with their derivatives, ``track_force_slopes_f``) per step: these take plain floats and a
+# patch with its constants worked out once, and give the same bits as ``slip`` and
+# ``track_force_n`` (same operations in the same order; expm1 is numpy's, whose vectorised
+# routine is not libm's).
 
 def slip_f(track_speed_mps: float, ground_speed_mps: float,
            min_track_speed_mps: float = 0.05) -> float:
