@@ -166,9 +166,10 @@ def effective_weight_n(displacement_n: float, submerged_volume_m3: ArrayLike,
                        slope_rad: ArrayLike, water_density_kgpm3: float,
                        gravity_mps2: float) -> ArrayLike:
     """W_e = (Delta - rho g V) cos(theta), never negative (afloat gives 0), N."""
-    if is_scalar(submerged_volume_m3) and is_scalar(slope_rad):     # scalar path, same bits
+    if is_scalar(submerged_volume_m3) and is_scalar(slope_rad) \
+            and is_scalar(displacement_n):                         # scalar path, same bits
         buoyancy_n = water_density_kgpm3 * gravity_mps2 * float(submerged_volume_m3)
-        return max(displacement_n - buoyancy_n, 0.0) * _cos(float(slope_rad))
+        return max(float(displacement_n) - buoyancy_n, 0.0) * _cos(float(slope_rad))
     buoyancy = water_density_kgpm3 * gravity_mps2 * np.asarray(submerged_volume_m3, dtype=float)
     out = np.maximum(displacement_n - buoyancy, 0.0) * np.cos(slope_rad)
     return float(out) if np.ndim(out) == 0 else out
