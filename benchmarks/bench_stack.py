@@ -54,7 +54,7 @@ import numpy as np
 from dukw_bringup.bringup import Runner, load_stack, stack_path
 from dukw_bringup.mission import load_mission
 from dukw_bringup.run_setup import prepare_run
-from dukw_bringup.stack_metrics import chain_latencies, cpu_seconds
+from dukw_bringup.stack_metrics import chain_latencies, cpu_seconds, thread_cpu_seconds
 from dukw_common.config import default_config_path
 from figures import report
 
@@ -240,10 +240,12 @@ def measure(stack_name: str, args: argparse.Namespace) -> int:
         probe.spin(args.warmup)
         pids = runner.pids()
         cpu0 = {name: cpu_seconds(pid) for name, pid in pids.items()}
+        dds0 = {name: thread_cpu_seconds(pid) for name, pid in pids.items()}
         wall0, window0 = time.monotonic(), time.monotonic_ns()
         probe.spin(args.duration)
         wall, window = time.monotonic() - wall0, (window0, time.monotonic_ns())
         cpu = {name: cpu_seconds(pid) - cpu0[name] for name, pid in pids.items()}
+        dds = {name: thread_cpu_seconds(pid) - dds0[name] for name, pid in pids.items()}
         dead = runner.poll()
     finally:
         probe.close()
@@ -259,9 +261,11 @@ def measure(stack_name: str, args: argparse.Namespace) -> int:
           f'processes {pinning}; {priorities(stack)}')
     report_latency(load_traces(trace_dir, pids), probe.takes, window,
                    label(stack.name, args.cores, args.normal_priority))
-    print('CPU share of one core:')
+    print("CPU share of one core (in brackets: of it Fast DDS's own threads; the rest is "
+          "the executor's thread: taking, converting and handling the messages):")
     for name, seconds in cpu.items():
-        print(f'  {name:<24} {100.0 * seconds / wall:6.1f} %')
+        print(f'  {name:<24} {100.0 * seconds / wall:6.1f} %   (DDS threads '
+              f'{100.0 * dds[name] / wall:4.1f} %)')
     without_sim = sum(s for n, s in cpu.items() if n != SIM_NODE)
     print(f'  {"stack without the sim":<24} {100.0 * without_sim / wall:6.1f} %'
           '   target <= 25 %, aim 15 %')

@@ -26,6 +26,27 @@ def cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / CLOCK_TICKS
 
 
+def thread_cpu_seconds(pid: int, prefix: str = 'dds.') -> float:
+    """utime + stime of a process's threads whose name starts with ``prefix``, s (Fast DDS
+    names its transport and event threads dds.*; the rest of a node's CPU is its executor's
+    thread: taking, converting and handling the messages). NaN once the process is gone."""
+    total = 0
+    try:
+        tasks = list(Path(f'/proc/{pid}/task').iterdir())
+    except OSError:
+        return float('nan')
+    for task in tasks:
+        try:
+            stat = (task / 'stat').read_text()
+        except OSError:                      # the thread ended meanwhile
+            continue
+        name, rest = stat.split('(', 1)[1].rsplit(')', 1)
+        if name.startswith(prefix):
+            fields = rest.split()
+            total += int(fields[11]) + int(fields[12])
+    return total / CLOCK_TICKS
+
+
 @dataclass(frozen=True)
 class ChainLatency:
     """Sensor sample -> actuator command, one entry per sample that led to a command, s;

@@ -1,10 +1,13 @@
 """Latency pairing (from the processes' traces) and CPU time of the stack benchmark."""
+import ctypes
 import math
 import os
+import threading
+import time
 
 import pytest
 
-from dukw_bringup.stack_metrics import chain_latencies, cpu_seconds
+from dukw_bringup.stack_metrics import chain_latencies, cpu_seconds, thread_cpu_seconds
 
 
 MS = 1_000_000
@@ -60,3 +63,30 @@ def test_a_sample_outside_the_window_or_its_command_too_late_is_not_counted():
 def test_cpu_seconds_of_this_process_and_of_a_missing_one():
     assert cpu_seconds(os.getpid()) > 0.0
     assert math.isnan(cpu_seconds(2 ** 22 + 12345))
+
+
+def test_thread_cpu_seconds_counts_only_the_named_threads():
+    """A busy thread named dds.* (as Fast DDS names its threads) is counted, the busy main
+    thread of this process is not; a missing process gives NaN."""
+    libc = ctypes.CDLL(None, use_errno=True)
+    before = thread_cpu_seconds(os.getpid())
+
+    def busy() -> None:
+        libc.prctl(15, b'dds.test_busy', 0, 0, 0)        # PR_SET_NAME: this thread's name
+        end = time.process_time() + 0.3
+        while time.process_time() < end:
+            pass
+    thread = threading.Thread(target=busy)
+    thread.start()
+    while thread.is_alive():
+        counted = thread_cpu_seconds(os.getpid())
+        time.sleep(0.05)
+    thread.join()
+    assert counted - before >= 0.1
+    main_before = thread_cpu_seconds(os.getpid())
+    end = time.process_time() + 0.2
+    while time.process_time() < end:      # the main thread (not dds.*) busy
+        pass
+    assert thread_cpu_seconds(os.getpid()) - main_before < 0.05
+    assert thread_cpu_seconds(os.getpid(), prefix='no-such-thread') == 0.0
+    assert math.isnan(thread_cpu_seconds(2 ** 22 + 12345))

@@ -166,16 +166,21 @@ def effective_weight_n(displacement_n: float, submerged_volume_m3: ArrayLike,
                        slope_rad: ArrayLike, water_density_kgpm3: float,
                        gravity_mps2: float) -> ArrayLike:
     """W_e = (Delta - rho g V) cos(theta), never negative (afloat gives 0), N."""
+    if is_scalar(submerged_volume_m3) and is_scalar(slope_rad) \
+            and is_scalar(displacement_n):                         # scalar path, same bits
+        buoyancy_n = water_density_kgpm3 * gravity_mps2 * float(submerged_volume_m3)
+        return max(float(displacement_n) - buoyancy_n, 0.0) * _cos(float(slope_rad))
     buoyancy = water_density_kgpm3 * gravity_mps2 * np.asarray(submerged_volume_m3, dtype=float)
     out = np.maximum(displacement_n - buoyancy, 0.0) * np.cos(slope_rad)
     return float(out) if np.ndim(out) == 0 else out
 
 
 # ------------------------------------------------------------------ float paths (hot callers)
-# The simulator solves each track's speed loop against the soil with a few dozen force
-# evaluations per step: these take plain floats and a patch with its constants worked out
-# once, and give the same bits as ``slip`` and ``track_force_n`` (same operations in the same
-# order; expm1 is numpy's, whose vectorised routine is not libm's).
+# The simulator solves each track's speed loop against the soil with a few force evaluations
+# (with their derivatives, ``track_force_slopes_f``) per step: these take plain floats and a
+# patch with its constants worked out once, and give the same bits as ``slip`` and
+# ``track_force_n`` (same operations in the same order; expm1 is numpy's, whose vectorised
+# routine is not libm's).
 
 def slip_f(track_speed_mps: float, ground_speed_mps: float,
            min_track_speed_mps: float = 0.05) -> float:
@@ -224,6 +229,18 @@ class TrackPatch:
 
 
 _TAN_OF: dict[float, float] = {}
+_COS_OF: dict[float, float] = {}
+
+
+def _cos(angle_rad: float) -> float:
+    """float(np.cos(angle)), remembered per angle (numpy's cos is not libm's; the slopes the
+    callers ask for are few)."""
+    cos_angle = _COS_OF.get(angle_rad)
+    if cos_angle is None:
+        if len(_COS_OF) > 1024:
+            _COS_OF.clear()
+        cos_angle = _COS_OF[angle_rad] = float(np.cos(angle_rad))
+    return cos_angle
 
 
 def _tan(phi_rad: float) -> float:
@@ -267,3 +284,69 @@ def track_force_f(patch: TrackPatch, track_speed_mps: float, ground_speed_mps: f
         dev = x / 2.0 if x < 1e-6 else 1.0 + float(_expm1(-x)) / x   # numpy's expm1
     h = strength * dev if i > 0.0 else -strength * dev
     return h if v_t >= 0.0 else -h
+
+
+def track_force_slopes_f(patch: TrackPatch, track_speed_mps: float,
+                         ground_speed_mps: float) -> tuple[float, float, float]:
+    """``track_force_f`` (the same bits) and its analytic derivatives: (force N, d force /
+    d track speed N s/m, d force / d ground speed N s/m).
+
+    The simulator's soil solve takes Newton steps on the track speed and linearises the force
+    in the ground speed: one call here instead of a force and two probes. Where the slip is
+    clipped (|i| = 1) only the pore suction's share varies; at no slip the derivative is the
+    bracket's slope there (the force is odd and smooth through i = 0)."""
+    v_t = track_speed_mps
+    slip_mps = v_t - ground_speed_mps
+    if v_t >= 0.0:                           # as track_force_f
+        held = not v_t > _MIN_TRACK_SPEED_MPS
+        denom = _MIN_TRACK_SPEED_MPS if held else v_t
+    else:
+        held = not -v_t > _MIN_TRACK_SPEED_MPS
+        denom = -(_MIN_TRACK_SPEED_MPS if held else -v_t)
+    i = slip_mps / denom
+    di_dg = -1.0 / denom
+    di_dv = -di_dg if held else (1.0 - i) / denom       # d/dv of (v - g) / v: g / v^2
+    if i < -1.0 or i > 1.0:
+        i = -1.0 if i < -1.0 else 1.0
+        di_dv = di_dg = 0.0
+    w = patch.weight_n
+    if w <= 0.0:
+        h = 0.0 if i >= 0.0 else -0.0
+        return (h if v_t >= 0.0 else -h), 0.0, 0.0
+    normal, ds_dv = w, 0.0
+    if patch.suction_on:
+        demand = patch.suction_ratio * abs(slip_mps) * patch.pressure_pa
+        s = patch.saturation * min(demand, patch.max_suction_pa)
+        if s:
+            normal = w + patch.area_m2 * s
+        if demand < patch.max_suction_pa:
+            ds_dv = patch.saturation * patch.suction_ratio * patch.pressure_pa * (
+                1.0 if slip_mps > 0.0 else -1.0 if slip_mps < 0.0 else 0.0)
+    strength = patch.cohesion_n + normal * patch.tan_phi
+    dstrength_dv = patch.area_m2 * ds_dv * patch.tan_phi     # d/dg: the opposite
+    slip_abs = i if i > 0.0 else -i
+    if patch.shear_modulus_m <= 1e-9:
+        dev = 1.0 if slip_abs > 0.0 else 0.0
+        ddev_da = 0.0
+    else:
+        x = slip_abs * patch.length_m / patch.shear_modulus_m    # as track_force_f
+        if x < 1e-6:
+            dev = x / 2.0
+        else:
+            e = float(_expm1(-x))
+            dev = 1.0 + e / x
+        # d dev / dx = -(e + x (e + 1)) / x^2, its series where that cancels
+        ddev_dx = 0.5 - x / 3.0 + x * x / 8.0 if x < 1e-3 else -(e + x * (e + 1.0)) / (x * x)
+        ddev_da = ddev_dx * patch.length_m / patch.shear_modulus_m
+    if i == 0.0:
+        h = 0.0 if i >= 0.0 else -0.0        # sign(i) x ...: as track_force_f
+        dh_dv, dh_dg = strength * ddev_da * di_dv, strength * ddev_da * di_dg
+    else:
+        sign = 1.0 if i > 0.0 else -1.0
+        h = strength * dev if i > 0.0 else -strength * dev
+        shear = strength * ddev_da
+        dh_dv = sign * dstrength_dv * dev + shear * di_dv
+        dh_dg = -sign * dstrength_dv * dev + shear * di_dg
+    if v_t >= 0.0:
+        return h, dh_dv, dh_dg
+    return -h, -dh_dv, -dh_dg

@@ -53,6 +53,19 @@ def test_no_weight_no_traction():
     assert traction.tractive_force_n(0.5, 0.0, SOIL, A, L) == 0.0
 
 
+def test_effective_weight_scalar_path_gives_the_array_path_bits():
+    """The scalar path (the simulator's every step on the sand) equals the array path to
+    the bit, zero weight afloat included."""
+    rng = np.random.default_rng(5)
+    volumes = np.concatenate([rng.uniform(0.0, 0.4, 200), [0.0, 0.2835, 0.5]])
+    slopes = np.concatenate([rng.uniform(0.0, 0.4, 200), [0.0, 0.0785, 0.0785]])
+    want = traction.effective_weight_n(2894.0, volumes, slopes, 1025.0, 9.80665)
+    got = [traction.effective_weight_n(2894.0, v, a, 1025.0, 9.80665)
+           for v, a in zip(volumes.tolist(), slopes.tolist(), strict=True)]
+    assert _bits(got) == _bits(want)
+    assert got[-1] == 0.0 and got[-3] > 0.0
+
+
 def test_effective_weight_goes_to_zero_afloat_and_scales_with_cos_slope():
     assert traction.effective_weight_n(2894.0, 0.0, 0.0, 1025, 9.81) == 2894.0
     assert traction.effective_weight_n(2894.0, 0.0, math.radians(11), 1025, 9.81) == \
@@ -202,3 +215,39 @@ def test_float_path_gives_the_array_path_bits(weight_n, saturation, soil):
     slips = [traction.slip_f(v, g) for v, g in pairs]
     assert _bits(slips) == _bits(traction.slip(speeds, grounds))
     assert patch.strength_n(450.0) == traction.max_traction_n(weight_n, soil, A / 2, 450.0)
+
+
+@pytest.mark.parametrize('weight_n, saturation, soil', [
+    (1200.0, 0.0, SOIL), (1200.0, 0.6, SOIL), (0.0, 0.5, SOIL),
+    (800.0, 0.8, SoilParams(0.0, math.radians(31.0), 0.0))])
+def test_force_slopes_give_the_force_bits_and_its_derivatives(weight_n, saturation, soil):
+    """track_force_slopes_f: the force of track_force_f to the bit, and derivatives in the
+    track and the ground speed that match central differences (away from the kinks: the
+    reversing track at v = 0, the held slip denominator at |v| = 0.05, the clip at |i| = 1,
+    the suction's cap; with no shear modulus the force steps at i = 0)."""
+    suction = SaturatedSandParams(suction_ratio_per_mps=0.9, max_pore_suction_pa=9000.0)
+    patch = traction.TrackPatch(weight_n, soil, A / 2, L, suction, saturation)
+    rng = np.random.default_rng(11)
+    speeds = np.concatenate([rng.uniform(-2.0, 2.0, 300), [0.0, -0.0, 0.03, -0.03, 0.8]])
+    grounds = np.concatenate([speeds[:300] + rng.normal(0.0, 0.3, 300), [0.0, 0.0, 0.0, 0.0,
+                                                                         0.8]])
+    step = 1e-6
+    checked = 0
+    for v, g in zip(speeds.tolist(), grounds.tolist(), strict=True):
+        force, d_track, d_ground = traction.track_force_slopes_f(patch, v, g)
+        assert _bits([force]) == _bits([traction.track_force_f(patch, v, g)])
+        i = traction.slip_f(v, g)
+        step_at_zero = abs(i) if soil.shear_modulus_m <= 1e-9 else 1.0
+        far = min(abs(v), abs(abs(v) - 0.05), 1.0 - abs(i), step_at_zero, abs(abs(v - g)
+                  - 9000.0 / 0.9 / (patch.pressure_pa or 1.0))) > 1e-3
+        if not far:
+            continue
+        f = traction.track_force_f
+        want_t = (f(patch, v + step, g) - f(patch, v - step, g)) / (2 * step)
+        want_g = (f(patch, v, g + step) - f(patch, v, g - step)) / (2 * step)
+        assert d_track == pytest.approx(want_t, rel=1e-4, abs=1e-2)
+        assert d_ground == pytest.approx(want_g, rel=1e-4, abs=1e-2)
+        checked += 1
+    assert checked > 200
+    if weight_n > 0.0 and soil.shear_modulus_m > 0.0:   # more track speed, more force
+        assert traction.track_force_slopes_f(patch, 0.8, 0.8)[1] > 0.0

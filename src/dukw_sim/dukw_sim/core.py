@@ -36,7 +36,8 @@ from dukw_sim.forces import (LATERAL_POINTS, BodyForces, Immersion, StripSums, W
                              strip_sums, sum_wrenches, surf_resistance, track_paddle_n,
                              track_wetness, water_yaw_rate_rps, wave_forcing, wave_moments)
 from dukw_sim.hull import HullGeometry, Seakeeping
-from dukw_sim.land import TrackContact, TrackLinear, linearise, motor_limited_speed
+from dukw_sim.land import (TrackContact, TrackLinear, linearise, motor_limited_speed,
+                           predicted_speeds)
 from dukw_sim.params import SimParams, apply_overrides
 from dukw_sim.truth import Medium, Truth
 from dukw_sim.world import (Beach, WaterSample, WaveModel, World, irregular_waves, no_waves,
@@ -587,9 +588,10 @@ class SimCore:
             if max(abs(g_next[0] - g_lin[0]), abs(g_next[1] - g_lin[1])) < _NEWTON_TOL_MPS:
                 converged = True
                 break
+            guess = predicted_speeds(lin, drives.loop_k, g_lin, g_next)
             g_lin = g_next
             lin = linearise(contact, tuple(self.ref), g_lin, tuple(others), drives.loop_k,
-                            tuple(lin.speed_mps))
+                            guess)
         if contact is not None:
             slip_p, slip_s = lin.speed_mps[0] - ground[0], lin.speed_mps[1] - ground[1]
             if slip_p * (slip_p - du + dr * half) < 0.0 \

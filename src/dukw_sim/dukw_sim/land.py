@@ -23,7 +23,6 @@ from dukw_common.vehicle import SaturatedSandParams, SoilParams
 from dukw_model import traction
 
 _GRID = np.linspace(0.0, 1.0, 41)
-_PROBE_MPS = 1e-3          # ground-speed step for the force derivative
 _COMPLIANCE_ITERATIONS = 60   # safeguarded Newton steps for the loaded track speed (the
                               # soil force is steep near no slip: up to ~40 bisections)
 _COMPLIANCE_TOL_N = 0.02
@@ -69,16 +68,18 @@ class TrackLinear:
 
 
 def _compliant_speeds(patch: traction.TrackPatch, strength: float, ref: list, ground: list,
-                      others: list, stiffness: list, guess: list) -> list:
+                      others: list, stiffness: list, guess: list) -> tuple:
     """Track speeds where the speed loops' force k (ref - v) equals soil + other forces.
 
     h(v) = F_soil(v, g) + others - k (ref - v) rises with v; safeguarded Newton inside the
-    bracket the soil's strength S gives: v in [ref - (S + o)/k, ref + (S - o)/k]. Both tracks
-    step together until both have converged; in floats, the two tracks written out (numpy on
-    two tracks, or lists of two, cost more than the physics), the same bits as the vectorised
-    form. Returns the speeds and, when they converged, the soil forces there (else None).
+    bracket the soil's strength S gives: v in [ref - (S + o)/k, ref + (S - o)/k], with the
+    soil's analytic slope (``traction.track_force_slopes_f``: one evaluation a pass, no
+    probe). Both tracks step together until both have converged; in floats, the two tracks
+    written out (numpy on two tracks, or lists of two, cost more than the physics). Returns
+    the speeds and, when they converged, the soil forces there and their derivatives in the
+    track and the ground speed (else None, None, None).
     """
-    force = traction.track_force_f
+    slopes = traction.track_force_slopes_f
     r0, r1 = ref
     g0, g1 = ground
     o0, o1 = others
@@ -87,37 +88,33 @@ def _compliant_speeds(patch: traction.TrackPatch, strength: float, ref: list, gr
     hi0, hi1 = r0 + (strength - o0) / k0, r1 + (strength - o1) / k1
     v0, v1 = min(max(guess[0], lo0), hi0), min(max(guess[1], lo1), hi1)
     for _ in range(_COMPLIANCE_ITERATIONS):
-        f0, f1 = force(patch, v0, g0), force(patch, v1, g1)
+        f0, dv0, dg0 = slopes(patch, v0, g0)
+        f1, dv1, dg1 = slopes(patch, v1, g1)
         h0, h1 = f0 + o0 - k0 * (r0 - v0), f1 + o1 - k1 * (r1 - v1)
         if abs(h0) < _COMPLIANCE_TOL_N and abs(h1) < _COMPLIANCE_TOL_N:
-            return [v0, v1], [f0, f1]
-        v0, lo0, hi0 = _newton_in_bracket(patch, v0, g0, f0, h0, k0, lo0, hi0)
-        v1, lo1, hi1 = _newton_in_bracket(patch, v1, g1, f1, h1, k1, lo1, hi1)
-    return [v0, v1], None
+            return [v0, v1], [f0, f1], [dv0, dv1], [dg0, dg1]
+        v0, lo0, hi0 = _newton_in_bracket(v0, h0, dv0 + k0, lo0, hi0)
+        v1, lo1, hi1 = _newton_in_bracket(v1, h1, dv1 + k1, lo1, hi1)
+    return [v0, v1], None, None, None
 
 
-def _newton_in_bracket(patch: traction.TrackPatch, v: float, ground: float, f: float,
-                       residual: float, stiffness: float, lo: float,
+def _newton_in_bracket(v: float, residual: float, slope: float, lo: float,
                        hi: float) -> tuple[float, float, float]:
     """One track's next compliant speed: the bracket narrowed by the residual's sign, then a
-    Newton step (numerical soil derivative plus the loop's stiffness), or the bisection when
-    the step leaves the bracket. Returns (speed, lo, hi)."""
+    Newton step (``slope``: the soil's derivative plus the loop's stiffness), or the
+    bisection when the step leaves the bracket. Returns (speed, lo, hi)."""
     if residual > 0.0:
         hi = v
     else:
         lo = v
-    slope = (traction.track_force_f(patch, v + _PROBE_MPS, ground) - f) / _PROBE_MPS
-    step = v - residual / (slope + stiffness)
+    step = v - residual / slope if slope > 0.0 else lo
     return (step if lo < step < hi else 0.5 * (lo + hi)), lo, hi
 
 
-def _derivatives(patch: traction.TrackPatch, speed: float, ground: float, f0: float,
-                 stiffness: float, soft: bool) -> float:
-    """d force / d ground speed of one track at (speed, ground) with force f0 there: the
-    soil's, or with a soft loop the series one D_g k / (k + D_t)."""
-    force = traction.track_force_f
-    d_g = (force(patch, speed, ground + _PROBE_MPS) - f0) / _PROBE_MPS
-    d_t = (force(patch, speed + _PROBE_MPS, ground) - f0) / _PROBE_MPS
+def _series_slope(d_t: float, d_g: float, stiffness: float, soft: bool) -> float:
+    """d force / d ground speed of one track from the soil's derivatives in the track speed
+    ``d_t`` and the ground speed ``d_g``: the soil's, or with a soft loop the series one
+    D_g k / (k + D_t)."""
     return d_g * stiffness / (stiffness + d_t) if soft else d_g
 
 
@@ -138,22 +135,38 @@ def linearise(contact: TrackContact | None, ref_mps: tuple, ground_mps: tuple,
     stiff = [float(stiffness_n_per_mps[0]), float(stiffness_n_per_mps[1])]
     soft = [math.isfinite(stiff[0]), math.isfinite(stiff[1])]
     patch = contact.patch
-    force = traction.track_force_f
+    slopes = traction.track_force_slopes_f
     speed = ref
-    f0 = None
+    f0 = d_t = d_g = None
     if soft[0] or soft[1]:
         guess = ref if guess_mps is None else [float(guess_mps[0]), float(guess_mps[1])]
         k_soft = [stiff[0] if soft[0] else 1.0, stiff[1] if soft[1] else 1.0]
-        loaded, f_loaded = _compliant_speeds(patch, contact.strength_n(slipping=True), ref,
-                                             ground, [float(others_n[0]), float(others_n[1])],
-                                             k_soft, guess)
+        loaded, f_loaded, dt_loaded, dg_loaded = _compliant_speeds(
+            patch, contact.strength_n(slipping=True), ref, ground,
+            [float(others_n[0]), float(others_n[1])], k_soft, guess)
         speed = [loaded[0] if soft[0] else ref[0], loaded[1] if soft[1] else ref[1]]
         if f_loaded is not None and soft[0] and soft[1]:
-            f0 = f_loaded                           # the forces at the converged speeds
+            f0, d_t, d_g = f_loaded, dt_loaded, dg_loaded   # at the converged speeds
     if f0 is None:
-        f0 = [force(patch, speed[0], ground[0]), force(patch, speed[1], ground[1])]
-    d_g = [_derivatives(patch, speed[i], ground[i], f0[i], stiff[i], soft[i]) for i in (0, 1)]
-    return TrackLinear(f0, d_g, list(speed))
+        port, stbd = slopes(patch, speed[0], ground[0]), slopes(patch, speed[1], ground[1])
+        f0, d_t, d_g = [port[0], stbd[0]], [port[1], stbd[1]], [port[2], stbd[2]]
+    return TrackLinear(f0, [_series_slope(d_t[0], d_g[0], stiff[0], soft[0]),
+                            _series_slope(d_t[1], d_g[1], stiff[1], soft[1])], list(speed))
+
+
+def predicted_speeds(lin: TrackLinear, stiffness_n_per_mps: tuple, ground_from_mps: tuple,
+                     ground_to_mps: tuple) -> tuple:
+    """The loaded tracks' speeds at the ground speeds ``ground_to_mps``, to first order from
+    ``lin`` (linearised at ``ground_from_mps``): along a soft loop's equilibrium
+    dv/dg = -(series dF/dg) / k = -D_g / (k + D_t); a stiff loop's track keeps its speed.
+    The Newton start of the next linearisation."""
+    out = []
+    for i in (0, 1):
+        k, speed = stiffness_n_per_mps[i], lin.speed_mps[i]
+        if math.isfinite(k):
+            speed -= lin.dforce_dground[i] / k * (ground_to_mps[i] - ground_from_mps[i])
+        out.append(speed)
+    return tuple(out)
 
 
 def motor_limited_speed(contact: TrackContact | None, ref_mps: float, ground_mps: float,
