@@ -133,7 +133,7 @@ def _make_world(vehicle: Vehicle, params: SimParams, rng: np.random.Generator) -
                                 w.mean_direction_rad, w.spreading_exponent_s, w.directions)
     else:
         waves = no_waves()
-    return World(beach, waves, w.breaking_ratio, w.reference_depth_m)
+    return World(beach, waves, w.breaking_ratio, w.reference_depth_m, w.second_order)
 
 
 class SimCore:

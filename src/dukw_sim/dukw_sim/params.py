@@ -11,7 +11,7 @@ from typing import Mapping
 from dukw_common.config import ConfigError, ParamValue, build_settings, require
 from dukw_common.vehicle import SoilParams, soil_params
 
-from dukw_sim.world import WaveModel
+from dukw_sim.world import SecondOrder, WaveModel
 
 # Override names accepted for the shared site block (the world's beach lives there).
 SITE_ALIASES = {'world.beach_slope_rad': 'site.beach_slope_rad',
@@ -57,10 +57,14 @@ class WaveParams:
     breaking_ratio: float
     surge_inertia_coeff: float
     drift_force_coeff: float
+    second_order: str                    # none | kinematics | full (world.SecondOrder)
 
     def __post_init__(self) -> None:
         if self.model not in WaveModel.ALL:
             raise ConfigError(f'waves.model must be one of {WaveModel.ALL}, got {self.model!r}')
+        if self.second_order not in SecondOrder.ALL:
+            raise ConfigError(f'waves.second_order must be one of {SecondOrder.ALL}, got '
+                              f'{self.second_order!r}')
         if self.significant_height_m < 0.0:
             raise ConfigError('waves.significant_height_m must be >= 0')
         _positive(self, 'peak_period_s', 'jonswap_gamma', 'reference_depth_m', 'breaking_ratio')
