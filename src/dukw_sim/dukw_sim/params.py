@@ -53,6 +53,7 @@ class WaveParams:
     mean_direction_rad: float
     spreading_exponent_s: float
     directions: int
+    spreading_by_frequency: bool         # s(f) of Mitsuyasu, s_max = spreading_exponent_s
     reference_depth_m: float
     breaking_ratio: float
     surge_inertia_coeff: float
@@ -76,6 +77,9 @@ class WaveParams:
         if self.spreading_exponent_s < 0.0 or self.directions < 1:
             raise ConfigError('waves.spreading_exponent_s must be >= 0 and '
                               'waves.directions >= 1')
+        if self.spreading_by_frequency and self.spreading_exponent_s == 0.0:
+            raise ConfigError('waves.spreading_by_frequency needs the cos-2s spreading '
+                              '(waves.spreading_exponent_s > 0: its s_max)')
         if self.spreading_exponent_s == 0.0 and self.directions != 1:
             raise ConfigError('waves.directions > 1 needs the cos-2s spreading '
                               '(waves.spreading_exponent_s > 0)')

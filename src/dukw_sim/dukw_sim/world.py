@@ -10,6 +10,8 @@ small angle), all with the dispersion of one reference depth so that phases stay
 coherent over the sloping bed; the kinematics (particle velocity, acceleration)
 use the local depth. Depth-limited breaking caps the wave height at
 ``breaking_ratio`` times the local still-water depth, so the dry beach stays dry.
+Optionally (``second_order``) the shallow water's bound second harmonics are added at the
+kinematic points: narrow-band Stokes second order, limited to the cnoidal wave's.
 """
 from __future__ import annotations
 
@@ -187,10 +189,20 @@ def spreading_offsets_rad(exponent_s: float, directions: int) -> np.ndarray:
     return np.interp((np.arange(directions) + 0.5) / directions, cdf, grid)
 
 
+def mitsuyasu_exponent(freq_over_peak: np.ndarray, s_max: float) -> np.ndarray:
+    """The cos-2s spreading exponent at frequency f / f_peak: s_max (f / f_p)^5 up to the peak,
+    s_max (f / f_p)^-2.5 above it (Mitsuyasu et al. 1975, as Goda, Random Seas and Design of
+    Maritime Structures, 2000, ch. 2, whose s_max = 10 is the wind sea's): the spectrum's
+    tail is spread wider than its peak."""
+    ratio = np.asarray(freq_over_peak, dtype=float)
+    return s_max * np.where(ratio <= 1.0, ratio ** 5.0, ratio ** -2.5)
+
+
 def irregular_waves(significant_height_m: float, peak_period_s: float, reference_depth_m: float,
                     rng: np.random.Generator, count: int = 32, gamma: float = 3.3,
                     spreading_rad: float = 0.0, direction_rad: float = math.pi,
-                    spreading_exponent_s: float = 0.0, directions: int = 1) -> WaveComponents:
+                    spreading_exponent_s: float = 0.0, directions: int = 1,
+                    spreading_by_frequency: bool = False) -> WaveComponents:
     """A JONSWAP sea as ``count`` components with random frequencies, phases and directions.
 
     Frequencies are drawn uniformly inside equal bins over [0.5, 3] f_peak (no
@@ -203,7 +215,9 @@ def irregular_waves(significant_height_m: float, peak_period_s: float, reference
     spectrum is split into ``directions`` equal-energy direction bins and each run of
     ``directions`` consecutive frequency bins takes them all in random order (a single
     summation: every component keeps its own frequency, so the field stays ergodic and
-    the cost stays ``count`` components).
+    the cost stays ``count`` components). ``spreading_by_frequency``: each component's bin
+    directions are those of its own frequency's exponent (``mitsuyasu_exponent``, s = s_max
+    = ``spreading_exponent_s`` at the peak).
     """
     if count < 1:
         raise ValueError('an irregular sea needs at least one component')
@@ -226,10 +240,16 @@ def irregular_waves(significant_height_m: float, peak_period_s: float, reference
     omega = 2.0 * math.pi * freq
     k = np.array([wavenumber(w, reference_depth_m) for w in omega])
     if spreading_exponent_s > 0.0:
-        offsets = spreading_offsets_rad(spreading_exponent_s, directions)
         runs = -(-count // directions)
         order = np.concatenate([rng.permutation(directions) for _ in range(runs)])[:count]
-        heading = direction_rad + offsets[order]
+        if spreading_by_frequency:
+            s_of_f = mitsuyasu_exponent(freq / fp, spreading_exponent_s)
+            heading = direction_rad + np.array([
+                spreading_offsets_rad(s_i, directions)[j]
+                for s_i, j in zip(s_of_f, order, strict=True)])
+        else:
+            heading = direction_rad + spreading_offsets_rad(spreading_exponent_s,
+                                                            directions)[order]
     else:
         heading = direction_rad + spreading_rad * rng.uniform(-1.0, 1.0, count)
     phase = rng.uniform(0.0, 2.0 * math.pi, count)
@@ -287,7 +307,8 @@ def cnoidal_second_harmonic(ursell: float) -> float:
 def cnoidal_factor(height_m: float, k_rpm: float, depth_m: float) -> float:
     """The cnoidal wave's second harmonic over Stokes's (shallow-water limit) at the Ursell
     number of this wave: 1 in deep and intermediate water, falling where Stokes's second
-    order over-predicts (U > ~25: the cnoidal range, Hedges 1995)."""
+    order over-predicts (large U, the cnoidal range: Hedges 1995, Regions of validity of
+    analytical wave theories, Proc. ICE Water Maritime and Energy 112)."""
     ursell = height_m * (2.0 * math.pi / k_rpm) ** 2 / depth_m ** 3
     if ursell <= 1e-9:
         return 1.0

@@ -7,8 +7,8 @@ import pytest
 from dukw_common.config import ConfigError
 from dukw_sim.core import SimCore
 from dukw_sim.world import (Beach, World, cnoidal_factor, cnoidal_second_harmonic,
-                            cos2s_density, irregular_waves, jonswap_density, no_waves,
-                            regular_waves, spreading_offsets_rad, wavenumber)
+                            cos2s_density, irregular_waves, jonswap_density, mitsuyasu_exponent,
+                            no_waves, regular_waves, spreading_offsets_rad, wavenumber)
 
 SLOPE = math.radians(4.5)
 
@@ -240,6 +240,8 @@ def test_short_crested_sea_keeps_hs_and_rocks_the_vehicle_sideways():
     {'waves.spreading_exponent_s': 10.0, 'waves.directions': 1},          # one direction
     {'waves.spreading_exponent_s': 0.0, 'waves.directions': 4},           # bins, no s
     {'waves.spreading_exponent_s': -1.0},
+    {'waves.spreading_exponent_s': 0.0, 'waves.directions': 1, 'waves.spreading_rad': 0.35,
+     'waves.spreading_by_frequency': True},                              # s(f) without s_max
 ])
 def test_inconsistent_spreading_settings_are_rejected(overrides):
     with pytest.raises(ConfigError):
@@ -359,3 +361,23 @@ def test_second_order_setting_is_checked_and_built_from_the_config():
     sim = SimCore.from_config(overrides={'waves.model': 'irregular',
                                          'waves.second_order': 'kinematics'})
     assert sim.world.second_order
+
+
+def test_spreading_by_frequency_widens_the_tail_and_keeps_the_rest_of_the_sea():
+    assert mitsuyasu_exponent(np.array([0.5, 1.0, 2.0]), 10.0) == pytest.approx(
+        [10.0 / 32.0, 10.0, 10.0 * 2.0 ** -2.5])
+    kwargs = {'count': 48, 'spreading_exponent_s': 10.0, 'directions': 6}
+    fixed = irregular_waves(0.28, 3.6, 0.76, np.random.default_rng(4), **kwargs)
+    by_f = irregular_waves(0.28, 3.6, 0.76, np.random.default_rng(4), spreading_by_frequency=True,
+                           **kwargs)
+    for name in ('amplitude_m', 'omega_rps', 'phase_rad'):   # the same draws
+        assert np.array_equal(getattr(fixed, name), getattr(by_f, name))
+    assert np.allclose(np.hypot(fixed.kx, fixed.ky), np.hypot(by_f.kx, by_f.ky))
+    f_over_peak = by_f.omega_rps / (2.0 * math.pi) * 3.6
+
+    def spread(waves, band):
+        offset = np.abs(np.arctan2(waves.ky, -waves.kx))[band]   # from shoreward (pi)
+        return float(np.mean(offset))
+    near, tail = np.abs(f_over_peak - 1.0) < 0.15, f_over_peak > 1.8
+    assert spread(by_f, near) == pytest.approx(spread(fixed, near), rel=0.35)
+    assert spread(by_f, tail) > 1.5 * spread(fixed, tail)
