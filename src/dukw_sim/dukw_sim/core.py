@@ -131,10 +131,11 @@ def _make_world(vehicle: Vehicle, params: SimParams, rng: np.random.Generator) -
     elif w.model == WaveModel.IRREGULAR and w.significant_height_m > 0.0:
         waves = irregular_waves(w.significant_height_m, w.peak_period_s, w.reference_depth_m,
                                 rng, w.components, w.jonswap_gamma, w.spreading_rad,
-                                w.mean_direction_rad, w.spreading_exponent_s, w.directions)
+                                w.mean_direction_rad, w.spreading_exponent_s, w.directions,
+                                w.spreading_by_frequency)
     else:
         waves = no_waves()
-    return World(beach, waves, w.breaking_ratio, w.reference_depth_m)
+    return World(beach, waves, w.breaking_ratio, w.reference_depth_m, w.second_order)
 
 
 class SimCore:

@@ -11,7 +11,7 @@ from typing import Mapping
 from dukw_common.config import ConfigError, ParamValue, build_settings, require
 from dukw_common.vehicle import SoilParams, soil_params
 
-from dukw_sim.world import WaveModel
+from dukw_sim.world import SecondOrder, WaveModel
 
 # Override names accepted for the shared site block (the world's beach lives there).
 SITE_ALIASES = {'world.beach_slope_rad': 'site.beach_slope_rad',
@@ -53,14 +53,19 @@ class WaveParams:
     mean_direction_rad: float
     spreading_exponent_s: float
     directions: int
+    spreading_by_frequency: bool         # s(f) of Mitsuyasu, s_max = spreading_exponent_s
     reference_depth_m: float
     breaking_ratio: float
     surge_inertia_coeff: float
     drift_force_coeff: float
+    second_order: str                    # none | kinematics | full (world.SecondOrder)
 
     def __post_init__(self) -> None:
         if self.model not in WaveModel.ALL:
             raise ConfigError(f'waves.model must be one of {WaveModel.ALL}, got {self.model!r}')
+        if self.second_order not in SecondOrder.ALL:
+            raise ConfigError(f'waves.second_order must be one of {SecondOrder.ALL}, got '
+                              f'{self.second_order!r}')
         if self.significant_height_m < 0.0:
             raise ConfigError('waves.significant_height_m must be >= 0')
         _positive(self, 'peak_period_s', 'jonswap_gamma', 'reference_depth_m', 'breaking_ratio')
@@ -72,6 +77,9 @@ class WaveParams:
         if self.spreading_exponent_s < 0.0 or self.directions < 1:
             raise ConfigError('waves.spreading_exponent_s must be >= 0 and '
                               'waves.directions >= 1')
+        if self.spreading_by_frequency and self.spreading_exponent_s == 0.0:
+            raise ConfigError('waves.spreading_by_frequency needs the cos-2s spreading '
+                              '(waves.spreading_exponent_s > 0: its s_max)')
         if self.spreading_exponent_s == 0.0 and self.directions != 1:
             raise ConfigError('waves.directions > 1 needs the cos-2s spreading '
                               '(waves.spreading_exponent_s > 0)')

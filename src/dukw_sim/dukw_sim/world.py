@@ -10,6 +10,8 @@ small angle), all with the dispersion of one reference depth so that phases stay
 coherent over the sloping bed; the kinematics (particle velocity, acceleration)
 use the local depth. Depth-limited breaking caps the wave height at
 ``breaking_ratio`` times the local still-water depth, so the dry beach stays dry.
+Optionally (``second_order``) the shallow water's bound second harmonics are added at the
+kinematic points: narrow-band Stokes second order, limited to the cnoidal wave's.
 """
 from __future__ import annotations
 
@@ -36,6 +38,16 @@ class WaveModel:
     REGULAR = 'regular'
     IRREGULAR = 'irregular'
     ALL = (NONE, REGULAR, IRREGULAR)
+
+
+class SecondOrder:
+    """What ``waves.second_order`` adds to the linear sea (``World``): nothing, the
+    second-order horizontal velocity and acceleration, or those and the surface's."""
+
+    NONE = 'none'
+    KINEMATICS = 'kinematics'
+    FULL = 'full'
+    ALL = (NONE, KINEMATICS, FULL)
 
 
 @dataclass(frozen=True)
@@ -177,10 +189,20 @@ def spreading_offsets_rad(exponent_s: float, directions: int) -> np.ndarray:
     return np.interp((np.arange(directions) + 0.5) / directions, cdf, grid)
 
 
+def mitsuyasu_exponent(freq_over_peak: np.ndarray, s_max: float) -> np.ndarray:
+    """The cos-2s spreading exponent at frequency f / f_peak: s_max (f / f_p)^5 up to the peak,
+    s_max (f / f_p)^-2.5 above it (Mitsuyasu et al. 1975, as Goda, Random Seas and Design of
+    Maritime Structures, 2000, ch. 2, whose s_max = 10 is the wind sea's): the spectrum's
+    tail is spread wider than its peak."""
+    ratio = np.asarray(freq_over_peak, dtype=float)
+    return s_max * np.where(ratio <= 1.0, ratio ** 5.0, ratio ** -2.5)
+
+
 def irregular_waves(significant_height_m: float, peak_period_s: float, reference_depth_m: float,
                     rng: np.random.Generator, count: int = 32, gamma: float = 3.3,
                     spreading_rad: float = 0.0, direction_rad: float = math.pi,
-                    spreading_exponent_s: float = 0.0, directions: int = 1) -> WaveComponents:
+                    spreading_exponent_s: float = 0.0, directions: int = 1,
+                    spreading_by_frequency: bool = False) -> WaveComponents:
     """A JONSWAP sea as ``count`` components with random frequencies, phases and directions.
 
     Frequencies are drawn uniformly inside equal bins over [0.5, 3] f_peak (no
@@ -193,7 +215,9 @@ def irregular_waves(significant_height_m: float, peak_period_s: float, reference
     spectrum is split into ``directions`` equal-energy direction bins and each run of
     ``directions`` consecutive frequency bins takes them all in random order (a single
     summation: every component keeps its own frequency, so the field stays ergodic and
-    the cost stays ``count`` components).
+    the cost stays ``count`` components). ``spreading_by_frequency``: each component's bin
+    directions are those of its own frequency's exponent (``mitsuyasu_exponent``, s = s_max
+    = ``spreading_exponent_s`` at the peak).
     """
     if count < 1:
         raise ValueError('an irregular sea needs at least one component')
@@ -216,20 +240,101 @@ def irregular_waves(significant_height_m: float, peak_period_s: float, reference
     omega = 2.0 * math.pi * freq
     k = np.array([wavenumber(w, reference_depth_m) for w in omega])
     if spreading_exponent_s > 0.0:
-        offsets = spreading_offsets_rad(spreading_exponent_s, directions)
         runs = -(-count // directions)
         order = np.concatenate([rng.permutation(directions) for _ in range(runs)])[:count]
-        heading = direction_rad + offsets[order]
+        if spreading_by_frequency:
+            s_of_f = mitsuyasu_exponent(freq / fp, spreading_exponent_s)
+            heading = direction_rad + np.array([
+                spreading_offsets_rad(s_i, directions)[j]
+                for s_i, j in zip(s_of_f, order, strict=True)])
+        else:
+            heading = direction_rad + spreading_offsets_rad(spreading_exponent_s,
+                                                            directions)[order]
     else:
         heading = direction_rad + spreading_rad * rng.uniform(-1.0, 1.0, count)
     phase = rng.uniform(0.0, 2.0 * math.pi, count)
     return WaveComponents(amplitude, omega, k * np.cos(heading), k * np.sin(heading), phase)
 
 
+def _mean_wavenumber(waves: WaveComponents, depth_m: float) -> float:
+    """Wavenumber of the components' mean frequency m1 / m0 at this depth, rad/m (0: none)."""
+    m0 = float(np.sum(waves.amplitude_m ** 2))
+    if m0 <= 0.0:
+        return 0.0
+    return wavenumber(float(np.sum(waves.amplitude_m ** 2 * waves.omega_rps)) / m0, depth_m)
+
+
+def stokes2_coefficients(k_rpm: float, depth_m: float, z_m: float) -> tuple[float, float]:
+    """Stokes second-order coefficients (F, G) of a wave of wavenumber k in depth d at the
+    height z (<= 0): for eta = a cos(psi) with the velocity a w cosh k(z+d) / sinh kd cos(psi),
+    the second-order velocity is F a^2 w cosh k(z+d) / sinh kd cos(2 psi) =
+    (3/4) a^2 w k cosh 2k(z+d) / sinh^4 kd cos(2 psi), the elevation's G a^2 cos(2 psi) =
+    (k a^2 / 4) cosh kd (2 + cosh 2kd) / sinh^3 kd cos(2 psi) (Dean and Dalrymple, Water Wave
+    Mechanics for Engineers and Scientists, 1991, ch. 11)."""
+    if k_rpm <= 0.0:
+        return 0.0, 0.0
+    kd, kz = k_rpm * depth_m, k_rpm * (z_m + depth_m)
+    sh = math.sinh(kd)
+    f_u = 0.75 * k_rpm * math.cosh(2.0 * kz) / (sh ** 3 * math.cosh(kz))
+    g_eta = 0.25 * k_rpm * math.cosh(kd) * (2.0 + math.cosh(2.0 * kd)) / sh ** 3
+    return f_u, g_eta
+
+
+def _elliptic_k(m: float) -> float:
+    """Complete elliptic integral of the first kind K(m), parameter m in [0, 1), by the
+    arithmetic-geometric mean."""
+    a, b = 1.0, math.sqrt(1.0 - m)
+    while abs(a - b) > 1e-15 * a:
+        a, b = 0.5 * (a + b), math.sqrt(a * b)
+    return math.pi / (2.0 * a)
+
+
+def cnoidal_second_harmonic(ursell: float) -> float:
+    """Second-harmonic to first-harmonic amplitude ratio of a cnoidal wave of Ursell number
+    U = H L^2 / d^3: 2q / (1 + q^2), q = exp(-pi K(1 - m) / K(m)) the nome, m from
+    U = 16/3 m K(m)^2 (the Fourier series of cn^2; Korteweg and de Vries 1895, Wiegel 1960).
+    Small U: 3 U / (32 pi^2), Stokes's second order in shallow water; U -> inf: 1 (solitary)."""
+    if ursell <= 0.0:
+        return 0.0
+    lo, hi, target = 0.0, 1.0 - 1e-12, 3.0 * ursell / 16.0
+    for _ in range(60):
+        m = 0.5 * (lo + hi)
+        lo, hi = (m, hi) if m * _elliptic_k(m) ** 2 < target else (lo, m)
+    q = math.exp(-math.pi * _elliptic_k(1.0 - m) / _elliptic_k(m))
+    return 2.0 * q / (1.0 + q * q)
+
+
+def cnoidal_factor(height_m: float, k_rpm: float, depth_m: float) -> float:
+    """The cnoidal wave's second harmonic over Stokes's (shallow-water limit) at the Ursell
+    number of this wave: 1 in deep and intermediate water, falling where Stokes's second
+    order over-predicts (large U, the cnoidal range: Hedges 1995, Regions of validity of
+    analytical wave theories, Proc. ICE Water Maritime and Energy 112)."""
+    ursell = height_m * (2.0 * math.pi / k_rpm) ** 2 / depth_m ** 3
+    if ursell <= 1e-9:
+        return 1.0
+    return cnoidal_second_harmonic(ursell) / (3.0 * ursell / (32.0 * math.pi ** 2))
+
+
 def no_waves() -> WaveComponents:
     """Calm water."""
     empty = np.zeros(0)
     return WaveComponents(empty, empty, empty, empty, empty)
+
+
+# The second-order terms as sums of products of the linear fields' columns at a kinematic
+# point: its cosine row [eta, u, v, a_x~, a_y~, a w cos] is 0..5 (a~: sum a w^2 T cos), its
+# sine row [eta^, u^, v^, a_x, a_y, eta_dot] 6..11. eta2 = G (eta eta - eta^ eta^),
+# u2 = F (eta u - eta^ u^), du2/dt = F (eta_dot u + a w cos u^ + eta a_x + eta^ a_x~);
+# (left, right, result column 0..4 = eta2 u2 v2 du2/dt dv2/dt, sign)
+_SECOND_ORDER_PAIRS = ((0, 0, 0, 1.0), (6, 6, 0, -1.0),
+                       (0, 1, 1, 1.0), (6, 7, 1, -1.0), (0, 2, 2, 1.0), (6, 8, 2, -1.0),
+                       (11, 1, 3, 1.0), (5, 7, 3, 1.0), (0, 9, 3, 1.0), (6, 3, 3, 1.0),
+                       (11, 2, 4, 1.0), (5, 8, 4, 1.0), (0, 10, 4, 1.0), (6, 4, 4, 1.0))
+_PAIR_LEFT = np.array([p[0] for p in _SECOND_ORDER_PAIRS])
+_PAIR_RIGHT = np.array([p[1] for p in _SECOND_ORDER_PAIRS])
+_SECOND_ORDER_SIGNS = np.zeros((len(_SECOND_ORDER_PAIRS), 5))
+for _row, (_left, _right, _column, _sign) in enumerate(_SECOND_ORDER_PAIRS):
+    _SECOND_ORDER_SIGNS[_row, _column] = _sign
 
 
 class WaterSample(NamedTuple):
@@ -260,10 +365,16 @@ class World:
     """
 
     def __init__(self, beach: Beach, waves: WaveComponents, breaking_ratio: float = 0.78,
-                 reference_depth_m: float = 0.76) -> None:
+                 reference_depth_m: float = 0.76,
+                 second_order: str = SecondOrder.NONE) -> None:
         if breaking_ratio <= 0.0:
             raise ValueError('breaking_ratio must be > 0')
+        if second_order not in SecondOrder.ALL:
+            raise ValueError(f'second_order must be one of {SecondOrder.ALL}, got '
+                             f'{second_order!r}')
         self.beach = beach
+        self.second_order = second_order != SecondOrder.NONE and waves.count > 0
+        self._second_order_surface = second_order == SecondOrder.FULL
         self.waves = waves
         self.breaking_ratio = breaking_ratio
         self.reference_depth_m = reference_depth_m
@@ -277,9 +388,21 @@ class World:
         # velocity (a w dir) and acceleration (a w^2 dir) weights before the depth transfer
         self._kin_weights = np.column_stack([a_omega[:, None] * dirs,
                                              (a_omega * waves.omega_rps)[:, None] * dirs])
-        # the result weights: amplitude, then the kinematic ones times the depth transfer
-        self._weights = np.zeros((waves.count, 5))
+        # the result weights: amplitude, then the kinematic ones times the depth transfer (and,
+        # for the second order, a w: the elevation's rate on the sine rows)
+        self._weights = np.zeros((waves.count, 6 if self.second_order else 5))
         self._weights[:, 0] = waves.amplitude_m
+        if self.second_order:
+            self._weights[:, 5] = a_omega
+        self._mean_k = _mean_wavenumber(waves, reference_depth_m)
+        self._stokes2 = (0.0, 0.0)      # second-order velocity and elevation coefficients
+        self._pair_weights = np.zeros((len(_SECOND_ORDER_PAIRS), 5))
+        if self.second_order:           # their cnoidal limit against the still depth
+            self._ursell_depth = np.linspace(_MIN_KINEMATIC_DEPTH_M, beach.sea_floor_depth_m, 96)
+            hs = waves.height_scale_m
+            self._ursell_factor = np.array([
+                cnoidal_factor(min(hs, breaking_ratio * d), self._mean_k, d)
+                for d in self._ursell_depth])
         # phase = [x, y, 1, quarter] @ [kx; ky; phase - omega t; -pi/2]
         self._wavenumbers = np.zeros((4, waves.count))
         self._wavenumbers[0], self._wavenumbers[1] = waves.kx, waves.ky
@@ -447,6 +570,8 @@ class World:
         if not kin_points:
             kin = np.zeros(0)
             return WaterSample(out[:n, 0], kin, kin, kin, kin)
+        if self.second_order:
+            self._add_second_order(out, n, kin_points)
         return WaterSample(out[:n, 0], out[:kin_points, 1], out[:kin_points, 2], out[n:, 3],
                            out[n:, 4])
 
@@ -468,8 +593,27 @@ class World:
             self._kin_per_sinh = self._kin_weights / np.sinh(self._k * depth)[:, None]
             self._sinh_depth = depth
         transfer = np.cosh(self._k * (zc + depth))
-        np.multiply(transfer[:, None], self._kin_per_sinh, out=self._weights[:, 1:])
+        np.multiply(transfer[:, None], self._kin_per_sinh, out=self._weights[:, 1:5])
         self._transfer_key = (zc, depth)
+        if self.second_order:
+            limit = float(_interp(depth, self._ursell_depth, self._ursell_factor))
+            f_u, g_eta = stokes2_coefficients(self._mean_k, depth, zc)
+            self._stokes2 = (limit * f_u, limit * g_eta)
+            self._pair_weights = _SECOND_ORDER_SIGNS * np.array(
+                [limit * g_eta if self._second_order_surface else 0.0] + [limit * f_u] * 4)
+
+    def _add_second_order(self, out: np.ndarray, n: int, kin: int) -> None:
+        """Add the narrow-band second-order (Stokes) terms at the kinematic points, in place:
+        with the complex linear fields Z = eta + i eta_hat and U = u + i u_hat (cosines on the
+        first rows, sines on the rows after the n-th), u2 = F Re(Z U), its time derivative
+        F Re(dZ/dt U + Z dU/dt) and eta2 = G Re(Z^2) (``stokes2_coefficients``): products of
+        pairs of the rows' columns (``_SECOND_ORDER_PAIRS``), summed by one product."""
+        both = np.concatenate((out[:kin], out[n:n + kin]), axis=1)
+        pairs = both.take(_PAIR_LEFT, axis=1)
+        pairs *= both.take(_PAIR_RIGHT, axis=1)
+        terms = _dot(pairs, self._pair_weights)      # eta2, u2, v2 | du2/dt, dv2/dt
+        out[:kin, :3] += terms[:, :3]
+        out[n:n + kin, 3:5] += terms[:, 3:5]
 
     def elevation_m(self, x_m: float, y_m: float, t_s: float) -> float:
         """Water surface above mean level at one point, m."""

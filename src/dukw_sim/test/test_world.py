@@ -6,7 +6,8 @@ import pytest
 
 from dukw_common.config import ConfigError
 from dukw_sim.core import SimCore
-from dukw_sim.world import (Beach, World, cos2s_density, irregular_waves, jonswap_density,
+from dukw_sim.world import (Beach, World, cnoidal_factor, cnoidal_second_harmonic,
+                            cos2s_density, irregular_waves, jonswap_density, mitsuyasu_exponent,
                             no_waves, regular_waves, spreading_offsets_rad, wavenumber)
 
 SLOPE = math.radians(4.5)
@@ -239,6 +240,8 @@ def test_short_crested_sea_keeps_hs_and_rocks_the_vehicle_sideways():
     {'waves.spreading_exponent_s': 10.0, 'waves.directions': 1},          # one direction
     {'waves.spreading_exponent_s': 0.0, 'waves.directions': 4},           # bins, no s
     {'waves.spreading_exponent_s': -1.0},
+    {'waves.spreading_exponent_s': 0.0, 'waves.directions': 1, 'waves.spreading_rad': 0.35,
+     'waves.spreading_by_frequency': True},                              # s(f) without s_max
 ])
 def test_inconsistent_spreading_settings_are_rejected(overrides):
     with pytest.raises(ConfigError):
@@ -253,3 +256,128 @@ def test_a_short_crested_sea_is_built_from_the_config():
     heading = np.arctan2(waves.ky, waves.kx)
     assert len(np.unique(np.round(heading, 9))) == 8
     assert waves.height_scale_m == pytest.approx(sim.params.waves.significant_height_m)
+
+
+def _short_crested_sea():
+    return irregular_waves(0.28, 3.6, 0.76, np.random.default_rng(3), count=24,
+                           spreading_exponent_s=10.0, directions=6)
+
+
+def test_second_order_of_a_regular_wave_is_stokes_second_order():
+    """Over the flat sea floor (1.5 m, Ursell number ~4: Stokes's range) a regular wave gets
+    Stokes's second-order velocity, acceleration and surface (Dean and Dalrymple ch. 11)."""
+    height, period, depth, z = 0.2, 3.6, 1.5, -0.3
+    waves = regular_waves(height, period, 0.76)
+    linear = World(beach(), waves, breaking_ratio=10.0)
+    full = World(beach(), waves, breaking_ratio=10.0, second_order='full')
+    k, omega, a = float(-waves.kx[0]), float(waves.omega_rps[0]), height / 2.0
+    limit = cnoidal_factor(waves.height_scale_m, k, depth)   # the breaking scale's height
+    assert 0.98 < limit < 1.0
+    u2 = limit * 0.75 * a * a * omega * k * math.cosh(2 * k * (depth + z)) \
+        / math.sinh(k * depth) ** 4
+    eta2 = limit * k * a * a / 4 * math.cosh(k * depth) * (2 + math.cosh(2 * k * depth)) \
+        / math.sinh(k * depth) ** 3
+    x = np.full(2, 40.0)                      # over the flat floor, where the depth is 1.5 m
+    for t in np.linspace(0.0, period, 7):
+        lin = linear.sample(x, np.zeros(2), t, 2, z)
+        got = full.sample(x, np.zeros(2), t, 2, z)
+        psi = -k * 40.0 - omega * t           # the wave travels towards -x: kx = -k
+        # shoreward (-x) velocity and its rate at twice the phase
+        assert got.velocity_x_mps[0] - lin.velocity_x_mps[0] == pytest.approx(
+            -u2 * math.cos(2 * psi), abs=1e-9)
+        assert got.accel_x_mps2[0] - lin.accel_x_mps2[0] == pytest.approx(
+            -2 * omega * u2 * math.sin(2 * psi), abs=1e-9)
+        assert got.elevation_m[0] - lin.elevation_m[0] == pytest.approx(
+            eta2 * math.cos(2 * psi), abs=1e-9)
+
+
+def test_cnoidal_limit_of_the_second_harmonic():
+    """Small Ursell numbers: Stokes's shallow-water second harmonic 3U / (32 pi^2); large ones:
+    the cnoidal wave's, rising towards the solitary wave's 1 (never above)."""
+    for ursell in (0.1, 1.0):
+        assert cnoidal_second_harmonic(ursell) == pytest.approx(
+            3 * ursell / (32 * math.pi ** 2), rel=2e-3 * max(ursell, 0.1))
+    ratios = [cnoidal_second_harmonic(u) for u in (5.0, 26.0, 48.0, 100.0, 1000.0)]
+    assert np.all(np.diff(ratios) > 0.0) and ratios[-1] < 1.0
+    assert ratios[2] == pytest.approx(0.378, abs=0.005)     # m = 0.972, nome q = 0.195
+    # the factor on Stokes's coefficient: 1 in deep water, < 1 in the shallows
+    assert cnoidal_factor(0.28, 0.8, 5.0) == pytest.approx(1.0, abs=1e-3)
+    assert 0.7 < cnoidal_factor(0.28, 0.8, 0.73) < 0.95
+    assert cnoidal_factor(0.08, 0.8, 0.73) > 0.97             # day 2's sea: nearly Stokes
+
+
+def test_second_order_acceleration_is_the_rate_of_its_velocity():
+    """In a short-crested sea over the slope the second-order acceleration is the time
+    derivative of the second-order velocity (both components)."""
+    world = World(beach(), _short_crested_sea(), second_order='kinematics')
+    x, y, dt = np.array([9.0, 10.0]), np.array([0.3, -0.4]), 1e-4
+    for t in (3.0, 17.2, 40.5):
+        before = world.sample(x, y, t - dt, 2, -0.35)
+        after = world.sample(x, y, t + dt, 2, -0.35)
+        now = world.sample(x, y, t, 2, -0.35)
+        for vel, acc in (('velocity_x_mps', 'accel_x_mps2'), ('velocity_y_mps', 'accel_y_mps2')):
+            rate = (getattr(after, vel) - getattr(before, vel)) / (2 * dt)
+            assert np.allclose(getattr(now, acc), rate, atol=1e-5)
+
+
+def test_second_order_options_change_what_they_name():
+    linear = World(beach(), _short_crested_sea())
+    kin = World(beach(), _short_crested_sea(), second_order='kinematics')
+    full = World(beach(), _short_crested_sea(), second_order='full')
+    none = World(beach(), _short_crested_sea(), second_order='none')
+    x, y = np.array([8.0, 9.0, 10.0]), np.array([0.4, -0.4, 0.0])
+    diffs = {'kin_u': [], 'kin_eta': [], 'full_eta': []}
+    for t in np.arange(0.0, 60.0, 0.5):
+        lin = linear.sample(x, y, t, 2, -0.35)
+        for got, want in zip(none.sample(x, y, t, 2, -0.35), lin, strict=True):
+            assert np.array_equal(got, want)                   # 'none': the linear sea
+        k, f = kin.sample(x, y, t, 2, -0.35), full.sample(x, y, t, 2, -0.35)
+        diffs['kin_u'].append(np.abs(k.velocity_x_mps - lin.velocity_x_mps).max())
+        diffs['kin_eta'].append(np.abs(k.elevation_m - lin.elevation_m).max())
+        diffs['full_eta'].append(np.abs(f.elevation_m[:2] - lin.elevation_m[:2]).max())
+        assert np.array_equal(f.velocity_x_mps, k.velocity_x_mps)
+        assert f.elevation_m[2] == lin.elevation_m[2]          # not a kinematic point
+    assert max(diffs['kin_eta']) == 0.0
+    assert max(diffs['kin_u']) > 0.02 and max(diffs['full_eta']) > 0.005
+    with pytest.raises(ValueError):
+        World(beach(), _short_crested_sea(), second_order='stokes')
+
+
+def test_second_order_rigid_sample_is_the_sample_at_the_moved_points():
+    world = World(beach(), _short_crested_sea(), second_order='full')
+    bx, by = np.array([-1.0, 0.0, 1.0, 0.5]), np.array([0.4, -0.4, 0.4, 0.0])
+    rows = world.rigid_rows(bx, by, 3)
+    for x0, yaw, t in ((9.3, 3.0, 20.0), (2.0, 0.3, 5.5), (30.0, 1.0, 8.0)):
+        c, s = math.cos(yaw), math.sin(yaw)
+        _, rigid = world.sample_rigid(rows, 4, x0, 0.0, c, s, t, -0.3)
+        plain = world.sample(x0 + c * bx - s * by, s * bx + c * by, t, 3, -0.3)
+        for got, want in zip(rigid, plain, strict=True):
+            assert np.allclose(got, want, rtol=0.0, atol=1e-12)
+
+
+def test_second_order_setting_is_checked_and_built_from_the_config():
+    with pytest.raises(ConfigError):
+        SimCore.from_config(overrides={'waves.model': 'irregular', 'waves.second_order': 'on'})
+    sim = SimCore.from_config(overrides={'waves.model': 'irregular',
+                                         'waves.second_order': 'kinematics'})
+    assert sim.world.second_order
+
+
+def test_spreading_by_frequency_widens_the_tail_and_keeps_the_rest_of_the_sea():
+    assert mitsuyasu_exponent(np.array([0.5, 1.0, 2.0]), 10.0) == pytest.approx(
+        [10.0 / 32.0, 10.0, 10.0 * 2.0 ** -2.5])
+    kwargs = {'count': 48, 'spreading_exponent_s': 10.0, 'directions': 6}
+    fixed = irregular_waves(0.28, 3.6, 0.76, np.random.default_rng(4), **kwargs)
+    by_f = irregular_waves(0.28, 3.6, 0.76, np.random.default_rng(4), spreading_by_frequency=True,
+                           **kwargs)
+    for name in ('amplitude_m', 'omega_rps', 'phase_rad'):   # the same draws
+        assert np.array_equal(getattr(fixed, name), getattr(by_f, name))
+    assert np.allclose(np.hypot(fixed.kx, fixed.ky), np.hypot(by_f.kx, by_f.ky))
+    f_over_peak = by_f.omega_rps / (2.0 * math.pi) * 3.6
+
+    def spread(waves, band):
+        offset = np.abs(np.arctan2(waves.ky, -waves.kx))[band]   # from shoreward (pi)
+        return float(np.mean(offset))
+    near, tail = np.abs(f_over_peak - 1.0) < 0.15, f_over_peak > 1.8
+    assert spread(by_f, near) == pytest.approx(spread(fixed, near), rel=0.35)
+    assert spread(by_f, tail) > 1.5 * spread(fixed, tail)
