@@ -1,10 +1,14 @@
-"""The motion filter: a 10-state EKF in the plane, with the waterline distance and the wave.
+"""The motion filter: a 13-state EKF in the plane, with the waterline distance, the wave and
+the soil's strength.
 
 State (``Idx``): odom position x, y; yaw; body surge u, sway v; yaw rate r; gyro-z bias;
 waterline distance s (along the slope, base_link seaward of the mean waterline); wave
 elevation eta at the vehicle and its rate (a noise-driven damped oscillator at the sea's
 peak frequency); the DGPS position error east/north (first-order Gauss-Markov), so that
-its slow drift is not taken for motion.
+its slow drift is not taken for motion; the soil's strength against the contact model's soil
+(a factor on the track forces' Wong model, 1 = that soil; a random walk), so that a beach
+weaker or stronger than the soil the estimator knows is not read as water: the wave is a
+zero-mean oscillation about the surveyed waterline, the soil lasts (issue 18).
 
 Predict and update are written with numpy directly rather than through filterpy's
 generic ``ExtendedKalmanFilter``: its update cannot gate an innovation before applying it
@@ -37,6 +41,7 @@ class Idx(IntEnum):
     ETA_RATE = 9
     GPS_BIAS_E = 10
     GPS_BIAS_N = 11
+    SOIL = 12
 
 
 N_STATES = len(Idx)
@@ -45,8 +50,14 @@ _X, _Y, _YAW, _U, _V, _R = (int(Idx.X), int(Idx.Y), int(Idx.YAW), int(Idx.U), in
                             int(Idx.R))
 _S, _ETA, _ETA_RATE, _GBE, _GBN = (int(Idx.S), int(Idx.ETA), int(Idx.ETA_RATE),
                                    int(Idx.GPS_BIAS_E), int(Idx.GPS_BIAS_N))
-#: The states the water-contact and depth measurements may correct.
-SURFACE_STATES = np.array([1.0 if i in (Idx.S, Idx.ETA, Idx.ETA_RATE) else 0.0 for i in Idx])
+#: The states the water-contact and track-force measurements may correct (the soil through
+#: its correlation with the surface: both explain one force).
+SURFACE_STATES = np.array([1.0 if i in (Idx.S, Idx.ETA, Idx.ETA_RATE, Idx.SOIL) else 0.0
+                           for i in Idx])
+#: The surface without the soil: a force update where the tracks carry little weight (the
+#: force's product of factor and weight is then far from linear in either).
+WATER_SURFACE_STATES = np.array([1.0 if i in (Idx.S, Idx.ETA, Idx.ETA_RATE) else 0.0
+                                 for i in Idx])
 #: A sounding afloat mixes the wave with the vehicle's heave: it may correct s only.
 WATERLINE_STATE = np.array([1.0 if i == Idx.S else 0.0 for i in Idx])
 
@@ -76,6 +87,7 @@ class ProcessNoise:
     wave_sigma_m: float
     gps_bias_sigma_m: float = 0.0
     gps_bias_tau_s: float = 1.0
+    soil_scale_per_sqrt_s: float = 0.0
 
     def wave_drive(self) -> float:
         """Spectral density driving the oscillator so that its stationary sigma is wave_sigma."""
@@ -165,7 +177,8 @@ class MotionEkf:
         bias_q = 2.0 * n.gps_bias_sigma_m ** 2 / n.gps_bias_tau_s
         return np.array([n.position_m ** 2, n.position_m ** 2, n.yaw_rad ** 2, accel_mps2 ** 2,
                          accel_mps2 ** 2, n.yaw_accel_rps2 ** 2, n.gyro_bias_rps ** 2,
-                         n.waterline_m ** 2, 0.0, n.wave_drive(), bias_q, bias_q])
+                         n.waterline_m ** 2, 0.0, n.wave_drive(), bias_q, bias_q,
+                         n.soil_scale_per_sqrt_s ** 2])
 
     def update(self, z: np.ndarray, hx: np.ndarray, H: np.ndarray, R: np.ndarray,
                gate: float, angle_rows: tuple[int, ...] = ()) -> Outcome:
