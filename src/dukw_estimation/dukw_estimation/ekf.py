@@ -1,5 +1,5 @@
-"""The motion filter: a 13-state EKF in the plane, with the waterline distance, the wave and
-the soil's strength.
+"""The motion filter: a 15-state EKF in the plane, with the waterline distance, the wave, the
+soil's strength and the accelerometers' gravity leak.
 
 State (``Idx``): odom position x, y; yaw; body surge u, sway v; yaw rate r; gyro-z bias;
 waterline distance s (along the slope, base_link seaward of the mean waterline); wave
@@ -8,7 +8,11 @@ peak frequency); the DGPS position error east/north (first-order Gauss-Markov), 
 its slow drift is not taken for motion; the soil's strength against the contact model's soil
 (a factor on the track forces' Wong model, 1 = that soil; a random walk), so that a beach
 weaker or stronger than the soil the estimator knows is not read as water: the wave is a
-zero-mean oscillation about the surveyed waterline, the soil lasts (issue 18).
+zero-mean oscillation about the surveyed waterline, the soil lasts (issue 18); and the
+surge and sway accelerations' slow error (first-order Gauss-Markov): gravity leaking through
+the IMU's attitude error (0.2 deg x g = 0.034 m/s^2 for ~10 s), which the velocity would
+otherwise integrate into a ground-speed bias of a few cm/s (issue 18: the slip at low belt
+speeds).
 
 Predict and update are written with numpy directly rather than through filterpy's
 generic ``ExtendedKalmanFilter``: its update cannot gate an innovation before applying it
@@ -42,6 +46,8 @@ class Idx(IntEnum):
     GPS_BIAS_E = 10
     GPS_BIAS_N = 11
     SOIL = 12
+    ACCEL_BIAS_X = 13
+    ACCEL_BIAS_Y = 14
 
 
 N_STATES = len(Idx)
@@ -50,6 +56,7 @@ _X, _Y, _YAW, _U, _V, _R = (int(Idx.X), int(Idx.Y), int(Idx.YAW), int(Idx.U), in
                             int(Idx.R))
 _S, _ETA, _ETA_RATE, _GBE, _GBN = (int(Idx.S), int(Idx.ETA), int(Idx.ETA_RATE),
                                    int(Idx.GPS_BIAS_E), int(Idx.GPS_BIAS_N))
+_ABX, _ABY = int(Idx.ACCEL_BIAS_X), int(Idx.ACCEL_BIAS_Y)
 #: The states the water-contact and track-force measurements may correct (the soil through
 #: its correlation with the surface: both explain one force).
 SURFACE_STATES = np.array([1.0 if i in (Idx.S, Idx.ETA, Idx.ETA_RATE, Idx.SOIL) else 0.0
@@ -88,6 +95,8 @@ class ProcessNoise:
     gps_bias_sigma_m: float = 0.0
     gps_bias_tau_s: float = 1.0
     soil_scale_per_sqrt_s: float = 0.0
+    accel_bias_sigma_mps2: float = 0.0
+    accel_bias_tau_s: float = 1.0
 
     def wave_drive(self) -> float:
         """Spectral density driving the oscillator so that its stationary sigma is wave_sigma."""
@@ -142,8 +151,9 @@ class MotionEkf:
         x[_YAW] = wrap_angle(yaw + r * dt)
         F[_YAW, _R] = dt
         if accel_body is not None:
-            x[_U] += accel_body[0] * dt
-            x[_V] += accel_body[1] * dt
+            x[_U] += (accel_body[0] - x[_ABX]) * dt
+            x[_V] += (accel_body[1] - x[_ABY]) * dt
+            F[_U, _ABX] = F[_V, _ABY] = -dt
         elif drive_target is not None:
             u_t, r_t, tau = drive_target
             k = min(dt / tau, 1.0)
@@ -163,6 +173,10 @@ class MotionEkf:
         x[_GBE] *= decay
         x[_GBN] *= decay
         F[_GBE, _GBE] = F[_GBN, _GBN] = decay
+        leak = 1.0 - dt / n.accel_bias_tau_s
+        x[_ABX] *= leak
+        x[_ABY] *= leak
+        F[_ABX, _ABX] = F[_ABY, _ABY] = leak
         accel = n.accel_mps2 if accel_noise_mps2 is None else accel_noise_mps2
         q_rate = self._q_rates.get(accel)
         if q_rate is None:
@@ -175,10 +189,11 @@ class MotionEkf:
         """The diagonal of the process noise per second with this acceleration noise."""
         n = self.noise
         bias_q = 2.0 * n.gps_bias_sigma_m ** 2 / n.gps_bias_tau_s
+        accel_q = 2.0 * n.accel_bias_sigma_mps2 ** 2 / n.accel_bias_tau_s
         return np.array([n.position_m ** 2, n.position_m ** 2, n.yaw_rad ** 2, accel_mps2 ** 2,
                          accel_mps2 ** 2, n.yaw_accel_rps2 ** 2, n.gyro_bias_rps ** 2,
                          n.waterline_m ** 2, 0.0, n.wave_drive(), bias_q, bias_q,
-                         n.soil_scale_per_sqrt_s ** 2])
+                         n.soil_scale_per_sqrt_s ** 2, accel_q, accel_q])
 
     def update(self, z: np.ndarray, hx: np.ndarray, H: np.ndarray, R: np.ndarray,
                gate: float, angle_rows: tuple[int, ...] = ()) -> Outcome:

@@ -75,6 +75,11 @@ class EkfSettings:
     q_yaw_accel_rps2: float = _f('process.yaw_accel_rps2', 'yaw-rate random walk', 1e-6, 100)
     q_gyro_bias_rps: float = _f('process.gyro_bias_rps', 'gyro bias random walk', 0, 1)
     q_waterline_m: float = _f('process.waterline_m', 'waterline distance random walk', 0, 10)
+    q_accel_bias_mps2: float = _f(
+        'process.accel_bias_mps2', "sigma of the surge and sway accelerations' slow error "
+        "(gravity through the IMU's attitude error; Gauss-Markov states, 0: none)", 0, 10)
+    q_accel_bias_tau_s: float = _f('process.accel_bias_tau_s', 'its correlation time',
+                                   0.1, 1e4)
     # initial covariance (sigmas)
     init_position_m: float = _f('initial_sigma.position_m', 'initial position sigma', 1e-4, 1e4)
     init_yaw_rad: float = _f('initial_sigma.yaw_rad', 'initial heading sigma', 1e-4, 10)
