@@ -30,6 +30,7 @@ VOLUME_CACHE_SIZE = 16
 DRY_MARGIN_M = 1e-6              # the surface this far below the hulls' bottom line: no volume
 # plain ints for the hot paths (indexing numpy with IntEnum members is slower)
 _YAW, _U, _R, _S, _ETA = int(Idx.YAW), int(Idx.U), int(Idx.R), int(Idx.S), int(Idx.ETA)
+_SOIL = int(Idx.SOIL)
 
 
 def ground_speeds(x: np.ndarray, hull_separation_m: float) -> tuple[float, float]:
@@ -277,13 +278,14 @@ class ContactModel:
     def soil_force_n(self, x: np.ndarray, waterline_distance_m: float, surface_m: float,
                      track_mps: float, ground_mps: float) -> float:
         """Soil force on the vehicle from one track at these speeds, with the weight the
-        surface leaves it, N (heading from ``x``)."""
+        surface leaves it and the filter's soil strength factor, N (heading from ``x``)."""
         body = self.vehicle.body
         heading_cos = math.cos(x[_YAW] - self.settings.seaward_yaw_rad)
         volume = self.grounded_volume_m3(waterline_distance_m, surface_m, heading_cos)
         weight = self._effective_weight_n(min(volume, body.displaced_volume_m3))
-        return self.track_force_n(track_mps, ground_mps, 0.5 * weight,
-                                  self.saturation(waterline_distance_m, surface_m, heading_cos))
+        return x[_SOIL] * self.track_force_n(
+            track_mps, ground_mps, 0.5 * weight,
+            self.saturation(waterline_distance_m, surface_m, heading_cos))
 
     def saturation(self, waterline_distance_m: float, surface_m: float,
                    heading_cos: float) -> float:

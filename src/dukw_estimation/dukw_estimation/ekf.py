@@ -1,10 +1,18 @@
-"""The motion filter: a 10-state EKF in the plane, with the waterline distance and the wave.
+"""The motion filter: a 15-state EKF in the plane, with the waterline distance, the wave, the
+soil's strength and the accelerometers' gravity leak.
 
 State (``Idx``): odom position x, y; yaw; body surge u, sway v; yaw rate r; gyro-z bias;
 waterline distance s (along the slope, base_link seaward of the mean waterline); wave
 elevation eta at the vehicle and its rate (a noise-driven damped oscillator at the sea's
 peak frequency); the DGPS position error east/north (first-order Gauss-Markov), so that
-its slow drift is not taken for motion.
+its slow drift is not taken for motion; the soil's strength against the contact model's soil
+(a factor on the track forces' Wong model, 1 = that soil; a random walk), so that a beach
+weaker or stronger than the soil the estimator knows is not read as water: the wave is a
+zero-mean oscillation about the surveyed waterline, the soil lasts (issue 18); and the
+surge and sway accelerations' slow error (first-order Gauss-Markov): gravity leaking through
+the IMU's attitude error (0.2 deg x g = 0.034 m/s^2 for ~10 s), which the velocity would
+otherwise integrate into a ground-speed bias of a few cm/s (issue 18: the slip at low belt
+speeds).
 
 Predict and update are written with numpy directly rather than through filterpy's
 generic ``ExtendedKalmanFilter``: its update cannot gate an innovation before applying it
@@ -37,6 +45,9 @@ class Idx(IntEnum):
     ETA_RATE = 9
     GPS_BIAS_E = 10
     GPS_BIAS_N = 11
+    SOIL = 12
+    ACCEL_BIAS_X = 13
+    ACCEL_BIAS_Y = 14
 
 
 N_STATES = len(Idx)
@@ -45,8 +56,15 @@ _X, _Y, _YAW, _U, _V, _R = (int(Idx.X), int(Idx.Y), int(Idx.YAW), int(Idx.U), in
                             int(Idx.R))
 _S, _ETA, _ETA_RATE, _GBE, _GBN = (int(Idx.S), int(Idx.ETA), int(Idx.ETA_RATE),
                                    int(Idx.GPS_BIAS_E), int(Idx.GPS_BIAS_N))
-#: The states the water-contact and depth measurements may correct.
-SURFACE_STATES = np.array([1.0 if i in (Idx.S, Idx.ETA, Idx.ETA_RATE) else 0.0 for i in Idx])
+_ABX, _ABY = int(Idx.ACCEL_BIAS_X), int(Idx.ACCEL_BIAS_Y)
+#: The states the water-contact and track-force measurements may correct (the soil through
+#: its correlation with the surface: both explain one force).
+SURFACE_STATES = np.array([1.0 if i in (Idx.S, Idx.ETA, Idx.ETA_RATE, Idx.SOIL) else 0.0
+                           for i in Idx])
+#: The surface without the soil: a force update where the tracks carry little weight (the
+#: force's product of factor and weight is then far from linear in either).
+WATER_SURFACE_STATES = np.array([1.0 if i in (Idx.S, Idx.ETA, Idx.ETA_RATE) else 0.0
+                                 for i in Idx])
 #: A sounding afloat mixes the wave with the vehicle's heave: it may correct s only.
 WATERLINE_STATE = np.array([1.0 if i == Idx.S else 0.0 for i in Idx])
 
@@ -76,6 +94,9 @@ class ProcessNoise:
     wave_sigma_m: float
     gps_bias_sigma_m: float = 0.0
     gps_bias_tau_s: float = 1.0
+    soil_scale_per_sqrt_s: float = 0.0
+    accel_bias_sigma_mps2: float = 0.0
+    accel_bias_tau_s: float = 1.0
 
     def wave_drive(self) -> float:
         """Spectral density driving the oscillator so that its stationary sigma is wave_sigma."""
@@ -130,8 +151,9 @@ class MotionEkf:
         x[_YAW] = wrap_angle(yaw + r * dt)
         F[_YAW, _R] = dt
         if accel_body is not None:
-            x[_U] += accel_body[0] * dt
-            x[_V] += accel_body[1] * dt
+            x[_U] += (accel_body[0] - x[_ABX]) * dt
+            x[_V] += (accel_body[1] - x[_ABY]) * dt
+            F[_U, _ABX] = F[_V, _ABY] = -dt
         elif drive_target is not None:
             u_t, r_t, tau = drive_target
             k = min(dt / tau, 1.0)
@@ -151,6 +173,10 @@ class MotionEkf:
         x[_GBE] *= decay
         x[_GBN] *= decay
         F[_GBE, _GBE] = F[_GBN, _GBN] = decay
+        leak = 1.0 - dt / n.accel_bias_tau_s
+        x[_ABX] *= leak
+        x[_ABY] *= leak
+        F[_ABX, _ABX] = F[_ABY, _ABY] = leak
         accel = n.accel_mps2 if accel_noise_mps2 is None else accel_noise_mps2
         q_rate = self._q_rates.get(accel)
         if q_rate is None:
@@ -163,9 +189,11 @@ class MotionEkf:
         """The diagonal of the process noise per second with this acceleration noise."""
         n = self.noise
         bias_q = 2.0 * n.gps_bias_sigma_m ** 2 / n.gps_bias_tau_s
+        accel_q = 2.0 * n.accel_bias_sigma_mps2 ** 2 / n.accel_bias_tau_s
         return np.array([n.position_m ** 2, n.position_m ** 2, n.yaw_rad ** 2, accel_mps2 ** 2,
                          accel_mps2 ** 2, n.yaw_accel_rps2 ** 2, n.gyro_bias_rps ** 2,
-                         n.waterline_m ** 2, 0.0, n.wave_drive(), bias_q, bias_q])
+                         n.waterline_m ** 2, 0.0, n.wave_drive(), bias_q, bias_q,
+                         n.soil_scale_per_sqrt_s ** 2, accel_q, accel_q])
 
     def update(self, z: np.ndarray, hx: np.ndarray, H: np.ndarray, R: np.ndarray,
                gate: float, angle_rows: tuple[int, ...] = ()) -> Outcome:

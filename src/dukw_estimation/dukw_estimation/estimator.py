@@ -57,6 +57,7 @@ class Estimator:
         from it."""
         self.online_soil.reset(soil)
         self._use_online_soil()
+        self._reset_soil_scale()
 
     @property
     def ekf(self) -> MotionEkf:
@@ -224,6 +225,19 @@ class Estimator:
                                     contact.track_area_m2, body.track_contact_length_m)
         if learnt:
             self._use_online_soil()
+            self._reset_soil_scale()
+
+    def _reset_soil_scale(self) -> None:
+        """The contact model's soil changed (learnt on dry sand, or a new prior): the filter's
+        soil strength factor back to 1, decorrelated, its spread the prior's shrunk as the
+        online fit's phi spread (tan phi carries the force at the surf's slips)."""
+        st, P, i = self.settings, self.ekf.P, int(Idx.SOIL)
+        shrink = self.online_soil.P[0, 0] / st.soil_online_phi_sigma_rad ** 2 \
+            if st.soil_online_enabled else 1.0
+        self.ekf.x[i] = 1.0
+        P[i, :] = 0.0
+        P[:, i] = 0.0
+        P[i, i] = st.soil_scale_sigma ** 2 * min(shrink, 1.0)
 
     def add_props(self, s: DriveStatus) -> Outcome:
         """Propeller thrusts, for the drive model afloat."""
@@ -278,8 +292,8 @@ class Estimator:
             x[Idx.S], x[Idx.ETA], math.cos(x[Idx.YAW] - self.settings.seaward_yaw_rad))
         for k in range(2):
             slips[k] = traction.slip(speeds[k], ground[k])
-            predicted[k] = self.contact.track_force_n(speeds[k], ground[k], 0.5 * weight_n,
-                                                      saturation)
+            predicted[k] = x[Idx.SOIL] * self.contact.track_force_n(
+                speeds[k], ground[k], 0.5 * weight_n, saturation)
         return slips, predicted
 
     def health(self, now_s: float) -> list[Health]:

@@ -65,12 +65,19 @@ class MotionFilter:
                        st.init_yaw_rate_rps ** 2, st.init_gyro_bias_rps ** 2,
                        st.waterline_sigma_m ** 2, st.wave_sigma_m ** 2 + 1e-6,
                        (st.wave_sigma_m * 2 * math.pi * st.wave_peak_frequency_hz) ** 2 + 1e-6,
-                       st.gps_bias_sigma_m ** 2, st.gps_bias_sigma_m ** 2])
+                       st.gps_bias_sigma_m ** 2, st.gps_bias_sigma_m ** 2,
+                       st.soil_scale_sigma ** 2, st.q_accel_bias_mps2 ** 2,
+                       st.q_accel_bias_mps2 ** 2])
         noise = ProcessNoise(st.q_position_m, st.q_yaw_rad, st.q_accel_mps2, st.q_yaw_accel_rps2,
                              st.q_gyro_bias_rps, st.q_waterline_m,
                              2 * math.pi * st.wave_peak_frequency_hz, st.wave_damping_ratio,
-                             st.wave_sigma_m, st.gps_bias_sigma_m, st.gps_bias_tau_s)
-        self.ekf = MotionEkf(np.zeros(N_STATES), p0, noise, st.seaward_yaw_rad)
+                             st.wave_sigma_m, st.gps_bias_sigma_m, st.gps_bias_tau_s,
+                             st.soil_scale_process_per_sqrt_s if st.soil_scale_sigma > 0.0
+                             else 0.0,         # sigma 0: the soil trusted, the factor 1
+                             st.q_accel_bias_mps2, st.q_accel_bias_tau_s)
+        x0 = np.zeros(N_STATES)
+        x0[Idx.SOIL] = 1.0               # the soil as the contact model knows it
+        self.ekf = MotionEkf(x0, p0, noise, st.seaward_yaw_rad)
         self.t_s: float | None = None
         self.last_t = {s: -math.inf for s in SENSORS}
         self.datum: tuple[float, float, float] | None = None

@@ -75,6 +75,11 @@ class EkfSettings:
     q_yaw_accel_rps2: float = _f('process.yaw_accel_rps2', 'yaw-rate random walk', 1e-6, 100)
     q_gyro_bias_rps: float = _f('process.gyro_bias_rps', 'gyro bias random walk', 0, 1)
     q_waterline_m: float = _f('process.waterline_m', 'waterline distance random walk', 0, 10)
+    q_accel_bias_mps2: float = _f(
+        'process.accel_bias_mps2', "sigma of the surge and sway accelerations' slow error "
+        "(gravity through the IMU's attitude error; Gauss-Markov states, 0: none)", 0, 10)
+    q_accel_bias_tau_s: float = _f('process.accel_bias_tau_s', 'its correlation time',
+                                   0.1, 1e4)
     # initial covariance (sigmas)
     init_position_m: float = _f('initial_sigma.position_m', 'initial position sigma', 1e-4, 1e4)
     init_yaw_rad: float = _f('initial_sigma.yaw_rad', 'initial heading sigma', 1e-4, 10)
@@ -169,10 +174,29 @@ class EkfSettings:
         'force_update.max_slip_spread', "no force update where the ground speed's uncertainty "
         "moves the model's force by more than this share of it (a small slip on a soft "
         'soil: the force then tells the slip, not the water; 0: off)', 0, 10)
+    contact_bracket_period_s: float = _f(
+        'contact.bracket_period_s', 'one water sensor wet, the other dry: the surface as '
+        "anywhere between their heights (the span's middle, sigma width / sqrt(12)), at most "
+        'this often (0: off)', 0, 60)
     water_dry_bound: bool = _f(
         'contact.dry_bound', 'both water sensors reading dry bound the surface below them: '
         'the surface states are projected onto that bound (a constraint, which confident '
         'track-force updates cannot outvote as they do a gated measurement)')
+    soil_scale_sigma: float = _f(
+        'soil_scale.sigma', "prior sigma of the soil's strength against the contact model's "
+        'soil (a factor on the Wong force, learnt with the surface from the track forces; '
+        '0: the soil trusted)', 0, 2)
+    soil_scale_process_per_sqrt_s: float = _f(
+        'soil_scale.process_per_sqrt_s', "random walk of the soil's strength factor, per "
+        'sqrt(s) (the sand changes along the beach)', 0, 1)
+    soil_scale_min_fraction: float = _f(
+        'soil_scale.min_fraction', "a track-force update moves the soil's factor only where "
+        'the tracks carry at least this share of the weight (less: the force is the product '
+        'of a small weight and the factor, far from linear in either)', 0, 1)
+    soil_scale_min: float = _f('soil_scale.min', "lower bound of the soil's strength factor",
+                               0.01, 1)
+    soil_scale_max: float = _f('soil_scale.max', "upper bound of the soil's strength factor",
+                               1, 100)
     soil_preset: str = _f('soil_preset', "soil preset name; '' uses soil.*")
     # the site's soil learnt online on dry sand (soil_online.py)
     soil_online_enabled: bool = _f('soil_online.enabled', 'learn phi and k of the site from '

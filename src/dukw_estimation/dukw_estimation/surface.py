@@ -15,7 +15,8 @@ import numpy as np
 from dukw_common.vehicle import Vehicle
 from dukw_model import traction
 from dukw_estimation.contact import ContactModel, ground_speeds
-from dukw_estimation.ekf import N_STATES, SURFACE_STATES, WATERLINE_STATE, Idx, MotionEkf, Outcome
+from dukw_estimation.ekf import (N_STATES, SURFACE_STATES, WATER_SURFACE_STATES, WATERLINE_STATE,
+                                 Idx, MotionEkf, Outcome)
 from dukw_common.readings import DepthReading, DriveStatus, WaterContact
 from dukw_estimation.settings import EkfSettings
 
@@ -39,6 +40,7 @@ class SurfaceObserver:
         self.force_update_t_s = -math.inf
         self.dry_sensors: tuple[tuple[float, float], ...] = ()   # (x, z): both read dry
         self.dry_t_s = -math.inf                                 # ... at this time
+        self.bracket_t_s = -math.inf     # the last update from one sensor wet, one dry
 
     # ------------------------------------------------------------------ wet / dry
     def water_contact(self, ekf: MotionEkf, s: WaterContact) -> Outcome:
@@ -57,8 +59,11 @@ class SurfaceObserver:
                 continue
             result = ekf.update_scalar(0.0, depth, h, self.settings.contact_m ** 2,
                                        self.settings.gate_water, only=SURFACE_STATES)
+            self.clip_soil_scale(ekf)
             if out is not Outcome.REJECTED_OUTLIER:
                 out = result
+        if bool(s.fore_wet) != bool(s.aft_wet):
+            self._bracket(ekf, s.t_s, sensors)
         if out is Outcome.IGNORED:
             out = Outcome.ACCEPTED    # consistent with the state: nothing to correct
         if self.settings.water_dry_bound:
@@ -67,6 +72,27 @@ class SurfaceObserver:
             self.dry_t_s = s.t_s
             self.bound_by_dry_sensors(ekf, s.t_s)
         return out
+
+    def _bracket(self, ekf: MotionEkf, t_s: float, sensors: tuple) -> None:
+        """One sensor wet, the other dry: the surface crosses the hulls somewhere between
+        the two sensors' heights, as likely anywhere in that span (width w): the mean of
+        the two sensors' water depths is 0 with variance w^2 / 12. Without it only the
+        span's ends (the gated updates above) speak, and on a soil other than the model's
+        the track forces hold the surface at the end with more water (issue 18). At most
+        every ``contact.bracket_period_s``: the surface's place within the span is the
+        same error from sample to sample until the waves move it."""
+        st = self.settings
+        if st.contact_bracket_period_s <= 0.0 or t_s - self.bracket_t_s \
+                < st.contact_bracket_period_s:
+            return
+        (d0, h0), (d1, h1) = (self._sensor_depth(ekf.x, x_m, z_m) for _, x_m, z_m in sensors)
+        width = abs(d0 - d1)
+        if width <= 0.0:
+            return
+        self.bracket_t_s = t_s
+        ekf.update_scalar(0.0, 0.5 * (d0 + d1), 0.5 * (h0 + h1), width * width / 12.0,
+                          st.gate_water, only=SURFACE_STATES)
+        self.clip_soil_scale(ekf)
 
     def bound_by_dry_sensors(self, ekf: MotionEkf, t_s: float) -> None:
         """Both sensors last read dry (fresh, on the sand): the surface is below both (the
@@ -86,6 +112,7 @@ class SurfaceObserver:
             spread = float(h_surface @ p_h)
             if spread > 0.0:
                 ekf.x -= SURFACE_STATES * p_h * (depth / spread)
+                self.clip_soil_scale(ekf)
 
     def _sensor_depth(self, x: np.ndarray, x_m: float, z_m: float) -> tuple[float, np.ndarray]:
         """Water over a sensor at body (x, z) of a vehicle on the slope, and its Jacobian."""
@@ -194,10 +221,20 @@ class SurfaceObserver:
         h = np.zeros(N_STATES)
         h[Idx.ETA] = per_m
         h[Idx.S] = per_m * sin_t         # the volume follows the water depth eta + s sin
+        if x[Idx.SOIL] > 0.0:
+            h[Idx.SOIL] = predicted / x[Idx.SOIL]    # the force is the factor x the model's
         var = st.force_update_sigma_n ** 2 + per_mps * per_mps * max(ground_var, 0.0) \
             + soil_spread * max(measured_n * measured_n, predicted * predicted)
+        learn_soil = self.contact.fraction >= st.soil_scale_min_fraction
         ekf.update_scalar(measured_n, predicted, h, var, st.force_update_gate,
-                          only=SURFACE_STATES)
+                          only=SURFACE_STATES if learn_soil else WATER_SURFACE_STATES)
+        self.clip_soil_scale(ekf)
+
+    def clip_soil_scale(self, ekf: MotionEkf) -> None:
+        """The soil's strength factor within ``soil_scale.min`` .. ``max`` (the paper's
+        fitted soils span about 0.5-1.5 of the 72 % fit's force at the surf's slips)."""
+        st = self.settings
+        ekf.x[Idx.SOIL] = min(max(ekf.x[Idx.SOIL], st.soil_scale_min), st.soil_scale_max)
 
     def _soil_relative_variance(self, track_mps: float, ground_mps: float) -> float:
         """The force model's relative variance from the soil's (phi, k) uncertainty: large
