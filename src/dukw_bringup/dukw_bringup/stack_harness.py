@@ -38,7 +38,8 @@ from dukw_estimation.samples import OdometryEstimate, TractionEstimate
 from dukw_control.convert import authority_usable
 from dukw_common.readings import reading_topic
 from dukw_sim.core import Actuation, SimCore
-from dukw_sim.sensors import SensorModel
+from dukw_sim.params import apply_overrides
+from dukw_sim.sensors import SensorConfig, SensorModel
 from dukw_sim.switch import RcChannels, SimServoSwitch
 from dukw_sim.truth import Truth
 
@@ -308,7 +309,8 @@ class ClosedLoop(Stack):
             raise ValueError(f"feedback must be 'truth' or 'ekf', got {feedback!r}")
         sim = SimCore.from_config(config, overrides=sim_overrides or {}, seed=seed)
         sim.reset(start, x_m, yaw_rad)
-        sim_params = node_params('sim_node', config)
+        # the overrides reach the sensor models and the servo switch too (noise.*, rates.*)
+        sim_params = apply_overrides(node_params('sim_node', config), sim_overrides or {})
         switch = SimServoSwitch(float(sim_params['command_timeout_s']),
                                 RcChannels.from_params(sim_params))
         ekf_params = node_params('ekf_node', config)
@@ -319,7 +321,8 @@ class ClosedLoop(Stack):
                                                      mode_settings)
         controller = DriveControllerRunner.from_params(
             node_params('drive_controller_node', config), controller_settings)
-        super().__init__(sim, SensorModel.from_config(config, seed=seed), ekf, mode_manager,
+        sensors = SensorModel(SensorConfig.from_params(sim_params), seed)
+        super().__init__(sim, sensors, ekf, mode_manager,
                          controller, switch, wire, sensor_filter, actuation)
         self.feedback = feedback
 

@@ -144,3 +144,12 @@ def test_sea_to_land_in_waves_changes_mode_once_each(feedback):
     assert [m for _, m, _ in loop.record.modes] == [Mode.WATER, Mode.TRANSITION, Mode.LAND]
     assert loop.truth.x_m < -5.0 and loop.truth.medium == 0          # up on the sand
     assert loop.record.props[-1] == (0.0, 0.0) and loop.record.tracks[-1][1] > 40.0
+
+
+def test_simulator_overrides_reach_the_sensor_models_too():
+    # a campaign's sim_overrides of sensor noise were silently dropped (only the simulator
+    # core saw them): the sensor models and the servo switch are built from the same params
+    quiet = closed_loop({'noise.gyro_std_rps': 0.0}, feedback='ekf')
+    plain = closed_loop(feedback='ekf')
+    assert quiet.sensors.config.noise.gyro_std_rps == 0.0
+    assert plain.sensors.config.noise.gyro_std_rps > 0.0
