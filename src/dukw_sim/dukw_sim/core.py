@@ -48,6 +48,8 @@ __all__ = ['Actuation', 'SimCore', 'SimParams']
 _LAND_FRACTION = 0.02          # submerged share of the afloat volume below which: LAND
 _NEWTON_PASSES = 3             # implicit track-soil solve
 _NEWTON_TOL_MPS = 2e-4
+_sum_of = np.add.reduce        # ndarray.sum() without its Python wrapper (same bits)
+_dot = getattr(np.dot, '_implementation', np.dot)   # np.dot without its dispatcher (same bits)
 _CLEAR_MARGIN_M = 1e-9          # touchdown's shortcut: clear of the sand by more than this
 
 
@@ -314,7 +316,7 @@ class SimCore:
         # eta - (z_cg + bottom - x sin(pitch) + y sin(roll)): one product for the tilt
         tilt = self._tilt_sines                  # (sin(pitch), sin(roll)), kept as an array
         tilt[0], tilt[1] = math.sin(pitch), math.sin(roll)
-        depths = eta[:self._n_stations] - np.dot(self._strip_tilt, tilt)   # dot: matmul's bits
+        depths = eta[:self._n_stations] - _dot(self._strip_tilt, tilt)   # dot: matmul's bits
         depths -= z_cg + self.hull.bottom_above_cg_m
         return depths
 
@@ -432,7 +434,7 @@ class SimCore:
         targets = self._advance_speed_refs(act)
         ref = self.ref
         ground = (self.u - self.r * self._half_sep, self.u + self.r * self._half_sep)
-        mean_depth = float(depths.sum()) / depths.size         # depths.mean(), same bits
+        mean_depth = float(_sum_of(depths)) / depths.size      # depths.mean(), same bits
         track_imm = min(max(mean_depth / self.seakeeping.equilibrium_depth_m, 0.0), 1.0)
         # a loaded loop's speed follows the load: take its reference (no feedback chatter)
         speeds = ref if math.isfinite(self._loop_k) else self.track_speed
