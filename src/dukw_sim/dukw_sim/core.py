@@ -50,6 +50,8 @@ _NEWTON_PASSES = 3             # implicit track-soil solve
 _NEWTON_TOL_MPS = 2e-4
 _sum_of = np.add.reduce        # ndarray.sum() without its Python wrapper (same bits)
 _dot = getattr(np.dot, '_implementation', np.dot)   # np.dot without its dispatcher (same bits)
+# NamedTuples of the step from all their fields' values, without their Python __new__
+_new_tuple = tuple.__new__
 _CLEAR_MARGIN_M = 1e-9          # touchdown's shortcut: clear of the sand by more than this
 
 
@@ -331,8 +333,8 @@ class SimCore:
         depths = self._strip_depths(water.elevation_m, self.z_cg, self.pitch, self.roll)
         areas = self.hull.areas_m2(depths)
         self._hydro_key = key
-        self._hydro_val = _Hydro(px, water, depths, areas,
-                                 strip_sums(areas, water, self._strip_basis))
+        self._hydro_val = _new_tuple(_Hydro, (px, water, depths, areas,
+                                              strip_sums(areas, water, self._strip_basis)))
         return self._hydro_val
 
     def _grounded_buoyancy(self) -> float:
@@ -390,8 +392,9 @@ class SimCore:
         self.t_s += dt
         accel = ((self.u - u0) / dt - self.r * self.v, (self.v - v0) / dt + self.r * self.u,
                  (self.heave_vel - hv0) / dt)
-        self.truth = self._compute_truth(act, _Stepped(tracks, thrust, w_eff, waves.fx_n,
-                                                       waves.fy_n, accel))
+        self.truth = self._compute_truth(act, _new_tuple(_Stepped, (tracks, thrust, w_eff,
+                                                                    waves.fx_n, waves.fy_n,
+                                                                    accel)))
         return self.truth
 
     def _contact_and_immersion(self) -> tuple[Immersion, float, _Hydro]:
@@ -452,7 +455,7 @@ class SimCore:
                   self._loop_k if targets[1] != 0.0 else math.inf)
         lin = linearise(contact, tuple(ref), ground, tuple(others), loop_k,
                         tuple(self.track_speed))
-        return _Drives(ground, others, paddle, loop_k, contact, lin)
+        return _new_tuple(_Drives, (ground, others, paddle, loop_k, contact, lin))
 
     def _track_contact(self, w_eff: float) -> TrackContact | None:
         """The tracks' patches on the sand: dry or wet soil by position; under the surf the
@@ -571,7 +574,8 @@ class SimCore:
         self.yaw = (self.yaw + dt * self.r + math.pi) % (2.0 * math.pi) - math.pi
         self.x += dt * (c * self.u - s * self.v)
         self.y += dt * (s * self.u + c * self.v)
-        return TrackState(speeds, new, [new[0] + others[0], new[1] + others[1]], slips)
+        return _new_tuple(TrackState, (speeds, new, [new[0] + others[0], new[1] + others[1]],
+                                       slips))
 
     def _solve_surge_yaw(self, base: tuple, drives: _Drives):
         """Surge and yaw-rate change, implicit in the soil forces: Newton passes, each

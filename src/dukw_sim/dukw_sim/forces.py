@@ -156,7 +156,7 @@ def immersion(areas_m2: np.ndarray, strip_length_m: float, rho_g: float,
         area_sum_m2 = float(areas_m2.sum())
     buoy = rho_g * strip_length_m * area_sum_m2
     volume = buoy / rho_g
-    return Immersion(strip_f, buoy, volume, min(volume / afloat_volume_m3, 1.0))
+    return _new_tuple(Immersion, (strip_f, buoy, volume, min(volume / afloat_volume_m3, 1.0)))
 
 
 class WaveForcing(NamedTuple):
@@ -188,7 +188,7 @@ def wave_forcing(calm: bool, areas_m2: np.ndarray, strip_length_m: float, water:
         wv = sums.vy / sums.area_m2
     else:
         wu = wv = 0.0
-    return WaveForcing(fwx, fwy, wu, wv)
+    return _new_tuple(WaveForcing, (fwx, fwy, wu, wv))
 
 
 def water_yaw_rate_rps(areas_m2: np.ndarray, water: WaterSample, station_x_m: np.ndarray,
@@ -262,7 +262,8 @@ def wave_moments(calm: bool, areas_m2: np.ndarray, strip_length_m: float, water:
     extra = (cm_y - cm_x) * rho_l * across
     # REP 103: a force to port below the centre of gravity lifts the port side (+ roll); a
     # force forward below it lifts the bow (- pitch)
-    return WaveMoments(yaw, -lever_z_m * fy_body, lever_z_m * fx_body, -s * extra, c * extra)
+    return _new_tuple(WaveMoments, (yaw, -lever_z_m * fy_body, lever_z_m * fx_body, -s * extra,
+                                    c * extra))
 
 
 def track_wetness(water_over_ground_m: np.ndarray, track_height_m: float) -> float:

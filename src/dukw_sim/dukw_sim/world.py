@@ -32,6 +32,7 @@ _dot = getattr(np.dot, '_implementation', np.dot)
 # ndarray.max() / .sum() without their Python wrappers (the methods call these reductions:
 # same bits), for the per-step small arrays
 _max_of = np.maximum.reduce
+_new_tuple = tuple.__new__     # a NamedTuple from all its fields' values, without its __new__
 _sum_of = np.add.reduce
 _MIN_KINEMATIC_DEPTH_M = 0.05
 
@@ -580,8 +581,8 @@ class World:
             return WaterSample(out[:n, 0], kin, kin, kin, kin)
         if self.second_order:
             self._add_second_order(out, n, kin_points)
-        return WaterSample(out[:n, 0], out[:kin_points, 1], out[:kin_points, 2], out[n:, 3],
-                           out[n:, 4])
+        return _new_tuple(WaterSample, (out[:n, 0], out[:kin_points, 1], out[:kin_points, 2],
+                                        out[n:, 3], out[n:, 4]))   # all fields: no __new__
 
     def _set_transfer(self, x_kin: np.ndarray, kin_height_m: float,
                       offshore: bool = False) -> None:
