@@ -380,8 +380,9 @@ class SimCore:
         thrust = self._thrust_n(act, water.elevation_m)
         moments = self._wave_moments(areas, water, (c, s), sums)
         if moments.extra_fy_n or moments.extra_fx_n:   # the strips' sway inertia coefficient
-            waves = waves._replace(fx_n=waves.fx_n + moments.extra_fx_n,
-                                   fy_n=waves.fy_n + moments.extra_fy_n)
+            waves = _new_tuple(WaveForcing, (waves.fx_n + moments.extra_fx_n,   # _replace
+                                             waves.fy_n + moments.extra_fy_n,
+                                             waves.water_u_mps, waves.water_v_mps))
         forces = self._body_forces(drives, imm, waves, thrust, w_eff, (u_rel, v_rel, r_rel),
                                    (c, s), moments.yaw_nm)
         tracks = self._integrate_plane(forces, drives, imm.fraction, (c, s))
