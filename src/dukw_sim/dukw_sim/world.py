@@ -33,6 +33,9 @@ _dot = getattr(np.dot, '_implementation', np.dot)
 # same bits), for the per-step small arrays
 _max_of = np.maximum.reduce
 _new_tuple = tuple.__new__     # a NamedTuple from all its fields' values, without its __new__
+# np.clip's ufunc without its Python wrappers (np.clip of floats calls it; same bits as
+# np.minimum(np.maximum(x, lo), hi))
+_clip = getattr(getattr(np, '_core', None), 'umath', np).clip
 _sum_of = np.add.reduce
 _MIN_KINEMATIC_DEPTH_M = 0.05
 
@@ -95,7 +98,7 @@ class Beach:
 
     def heights_m(self, x_m: np.ndarray) -> np.ndarray:
         """Vectorised ``height_m``."""
-        return np.minimum(np.maximum(x_m, self.flat_start_x_m), self._floor_x) * -self._tan
+        return _clip(x_m, self.flat_start_x_m, self._floor_x) * -self._tan   # min(max()): bits
 
     def distance_along_slope_m(self, x_m: float) -> float:
         """Signed distance from the mean waterline measured along the ground, m."""
