@@ -16,6 +16,9 @@ import numpy as np
 
 from dukw_model.scalars import is_scalar
 
+# np.clip's ufunc without its Python wrappers (np.clip of floats calls it; same bits)
+_clip = getattr(getattr(np, '_core', None), 'umath', np).clip
+
 ArrayLike = float | np.ndarray
 
 
@@ -172,8 +175,7 @@ class HullSection:
         # the same operations on the same operands as
         # h = r - min(max(d, 0), min(float_depth, 2r));
         # r^2 acos(h / r) - h sqrt(r^2 - h^2) + strut max(d - float_depth, 0)
-        h = np.maximum(d, 0.0)
-        np.minimum(h, min(self.float_depth_m, 2.0 * r), out=h)
+        h = _clip(d, 0.0, min(self.float_depth_m, 2.0 * r))   # min(max(d, 0), ...): same bits
         np.subtract(r, h, out=h)
         out = h / r
         np.arccos(out, out=out)

@@ -48,6 +48,10 @@ __all__ = ['Actuation', 'SimCore', 'SimParams']
 _LAND_FRACTION = 0.02          # submerged share of the afloat volume below which: LAND
 _NEWTON_PASSES = 3             # implicit track-soil solve
 _NEWTON_TOL_MPS = 2e-4
+_sum_of = np.add.reduce        # ndarray.sum() without its Python wrapper (same bits)
+_dot = getattr(np.dot, '_implementation', np.dot)   # np.dot without its dispatcher (same bits)
+# NamedTuples of the step from all their fields' values, without their Python __new__
+_new_tuple = tuple.__new__
 _CLEAR_MARGIN_M = 1e-9          # touchdown's shortcut: clear of the sand by more than this
 
 
@@ -314,7 +318,7 @@ class SimCore:
         # eta - (z_cg + bottom - x sin(pitch) + y sin(roll)): one product for the tilt
         tilt = self._tilt_sines                  # (sin(pitch), sin(roll)), kept as an array
         tilt[0], tilt[1] = math.sin(pitch), math.sin(roll)
-        depths = eta[:self._n_stations] - np.dot(self._strip_tilt, tilt)   # dot: matmul's bits
+        depths = eta[:self._n_stations] - _dot(self._strip_tilt, tilt)   # dot: matmul's bits
         depths -= z_cg + self.hull.bottom_above_cg_m
         return depths
 
@@ -329,8 +333,8 @@ class SimCore:
         depths = self._strip_depths(water.elevation_m, self.z_cg, self.pitch, self.roll)
         areas = self.hull.areas_m2(depths)
         self._hydro_key = key
-        self._hydro_val = _Hydro(px, water, depths, areas,
-                                 strip_sums(areas, water, self._strip_basis))
+        self._hydro_val = _new_tuple(_Hydro, (px, water, depths, areas,
+                                              strip_sums(areas, water, self._strip_basis)))
         return self._hydro_val
 
     def _grounded_buoyancy(self) -> float:
@@ -376,8 +380,9 @@ class SimCore:
         thrust = self._thrust_n(act, water.elevation_m)
         moments = self._wave_moments(areas, water, (c, s), sums)
         if moments.extra_fy_n or moments.extra_fx_n:   # the strips' sway inertia coefficient
-            waves = waves._replace(fx_n=waves.fx_n + moments.extra_fx_n,
-                                   fy_n=waves.fy_n + moments.extra_fy_n)
+            waves = _new_tuple(WaveForcing, (waves.fx_n + moments.extra_fx_n,   # _replace
+                                             waves.fy_n + moments.extra_fy_n,
+                                             waves.water_u_mps, waves.water_v_mps))
         forces = self._body_forces(drives, imm, waves, thrust, w_eff, (u_rel, v_rel, r_rel),
                                    (c, s), moments.yaw_nm)
         tracks = self._integrate_plane(forces, drives, imm.fraction, (c, s))
@@ -388,8 +393,9 @@ class SimCore:
         self.t_s += dt
         accel = ((self.u - u0) / dt - self.r * self.v, (self.v - v0) / dt + self.r * self.u,
                  (self.heave_vel - hv0) / dt)
-        self.truth = self._compute_truth(act, _Stepped(tracks, thrust, w_eff, waves.fx_n,
-                                                       waves.fy_n, accel))
+        self.truth = self._compute_truth(act, _new_tuple(_Stepped, (tracks, thrust, w_eff,
+                                                                    waves.fx_n, waves.fy_n,
+                                                                    accel)))
         return self.truth
 
     def _contact_and_immersion(self) -> tuple[Immersion, float, _Hydro]:
@@ -432,7 +438,7 @@ class SimCore:
         targets = self._advance_speed_refs(act)
         ref = self.ref
         ground = (self.u - self.r * self._half_sep, self.u + self.r * self._half_sep)
-        mean_depth = float(depths.sum()) / depths.size         # depths.mean(), same bits
+        mean_depth = float(_sum_of(depths)) / depths.size      # depths.mean(), same bits
         track_imm = min(max(mean_depth / self.seakeeping.equilibrium_depth_m, 0.0), 1.0)
         # a loaded loop's speed follows the load: take its reference (no feedback chatter)
         speeds = ref if math.isfinite(self._loop_k) else self.track_speed
@@ -450,7 +456,7 @@ class SimCore:
                   self._loop_k if targets[1] != 0.0 else math.inf)
         lin = linearise(contact, tuple(ref), ground, tuple(others), loop_k,
                         tuple(self.track_speed))
-        return _Drives(ground, others, paddle, loop_k, contact, lin)
+        return _new_tuple(_Drives, (ground, others, paddle, loop_k, contact, lin))
 
     def _track_contact(self, w_eff: float) -> TrackContact | None:
         """The tracks' patches on the sand: dry or wet soil by position; under the surf the
@@ -569,7 +575,8 @@ class SimCore:
         self.yaw = (self.yaw + dt * self.r + math.pi) % (2.0 * math.pi) - math.pi
         self.x += dt * (c * self.u - s * self.v)
         self.y += dt * (s * self.u + c * self.v)
-        return TrackState(speeds, new, [new[0] + others[0], new[1] + others[1]], slips)
+        return _new_tuple(TrackState, (speeds, new, [new[0] + others[0], new[1] + others[1]],
+                                       slips))
 
     def _solve_surge_yaw(self, base: tuple, drives: _Drives):
         """Surge and yaw-rate change, implicit in the soil forces: Newton passes, each

@@ -11,6 +11,7 @@ the last bit of results that are recorded in the golden bags.
 """
 from __future__ import annotations
 
+import functools
 import math
 from typing import NamedTuple
 
@@ -25,6 +26,8 @@ _BREAKAWAY_MPS = 0.05          # below this track speed the breakaway friction a
 LATERAL_POINTS = 5             # points along each track for the lateral resistance
 # np.clip's ufunc without its Python wrappers (np.clip of floats calls it; same bits)
 _clip = getattr(getattr(np, '_core', None), 'umath', np).clip
+_sum_of = np.add.reduce      # ndarray.sum() without its Python wrapper (same bits)
+_dot = getattr(np.dot, '_implementation', np.dot)   # np.dot without its dispatcher (same bits)
 
 
 class Wrench(NamedTuple):
@@ -41,6 +44,13 @@ class Wrench(NamedTuple):
     dx_du: float | None = None
     dy_dv: float | None = None
     dn_dr: float | None = None
+
+
+# Wrench(x_n, y_n, n_nm, dx_du, dy_dv, dn_dr) from the six values in order (None: no part),
+# and NamedTuples from their fields' values in general, without the NamedTuple's Python
+# __new__ (a dozen terms are made every step on the sand; ~0.3 us each)
+_new_tuple = tuple.__new__
+_wrench = functools.partial(_new_tuple, Wrench)
 
 
 class BodyForces(NamedTuple):
@@ -63,7 +73,7 @@ def sum_wrenches(terms: list[Wrench]) -> BodyForces:
             if value is not None:
                 acc += value
         total.append(acc)
-    return BodyForces(*total)
+    return _new_tuple(BodyForces, total)
 
 
 class StripSums(NamedTuple):
@@ -114,7 +124,7 @@ def strip_sums(areas_m2: np.ndarray, water: WaterSample, basis: np.ndarray) -> S
     n = areas_m2.size
     kin = np.array((basis[0], water.velocity_x_mps[:n], water.velocity_y_mps[:n],
                     water.accel_x_mps2[:n], water.accel_y_mps2[:n]))
-    return StripSums(*np.dot(basis * areas_m2, kin.T).ravel().tolist())   # dot: @ bits, cheaper
+    return _new_tuple(StripSums, _dot(basis * areas_m2, kin.T).ravel().tolist())   # dot: @'s bits
 
 
 def _sums_of(sums: StripSums | None, areas_m2: np.ndarray, water: WaterSample,
@@ -146,7 +156,7 @@ def immersion(areas_m2: np.ndarray, strip_length_m: float, rho_g: float,
         area_sum_m2 = float(areas_m2.sum())
     buoy = rho_g * strip_length_m * area_sum_m2
     volume = buoy / rho_g
-    return Immersion(strip_f, buoy, volume, min(volume / afloat_volume_m3, 1.0))
+    return _new_tuple(Immersion, (strip_f, buoy, volume, min(volume / afloat_volume_m3, 1.0)))
 
 
 class WaveForcing(NamedTuple):
@@ -178,7 +188,7 @@ def wave_forcing(calm: bool, areas_m2: np.ndarray, strip_length_m: float, water:
         wv = sums.vy / sums.area_m2
     else:
         wu = wv = 0.0
-    return WaveForcing(fwx, fwy, wu, wv)
+    return _new_tuple(WaveForcing, (fwx, fwy, wu, wv))
 
 
 def water_yaw_rate_rps(areas_m2: np.ndarray, water: WaterSample, station_x_m: np.ndarray,
@@ -252,7 +262,8 @@ def wave_moments(calm: bool, areas_m2: np.ndarray, strip_length_m: float, water:
     extra = (cm_y - cm_x) * rho_l * across
     # REP 103: a force to port below the centre of gravity lifts the port side (+ roll); a
     # force forward below it lifts the bow (- pitch)
-    return WaveMoments(yaw, -lever_z_m * fy_body, lever_z_m * fx_body, -s * extra, c * extra)
+    return _new_tuple(WaveMoments, (yaw, -lever_z_m * fy_body, lever_z_m * fx_body, -s * extra,
+                                    c * extra))
 
 
 def track_wetness(water_over_ground_m: np.ndarray, track_height_m: float) -> float:
@@ -261,7 +272,7 @@ def track_wetness(water_over_ground_m: np.ndarray, track_height_m: float) -> flo
     if water_over_ground_m.size == 0:
         return 0.0
     share = _clip(water_over_ground_m / track_height_m, 0.0, 1.0)
-    return float(share.sum()) / share.size                     # np.mean, same bits
+    return float(_sum_of(share)) / share.size                    # np.mean, same bits
 
 
 def saturated_share(water_over_ground_m: np.ndarray) -> float:
@@ -331,8 +342,8 @@ def track_paddle_n(paddle_coeff_n_per_mps2: float, ref_mps: float, u_rel_mps: fl
 
 def paddle_wrench(paddle_n: list[float], half_sep_m: float) -> Wrench:
     """Both tracks' paddle forces on the vehicle."""
-    return Wrench(x_n=paddle_n[0] + paddle_n[1],
-                  n_nm=(paddle_n[1] - paddle_n[0]) * half_sep_m)
+    return _wrench((paddle_n[0] + paddle_n[1], None, (paddle_n[1] - paddle_n[0]) * half_sep_m,
+                    None, None, None))
 
 
 def rolling_resistance(w_eff_n: float, ground_mps: tuple, land: LandParams,
@@ -349,8 +360,8 @@ def _coulomb_per_track(roll_n: float, ground_mps: tuple, half_sep_m: float) -> l
         th = math.tanh(ground_mps[i] / _ROLL_EPS_MPS)
         f = -roll_n * th
         dth = roll_n * (1.0 - th * th) / _ROLL_EPS_MPS
-        out.append(Wrench(x_n=f, n_nm=sign * f * half_sep_m, dx_du=-dth,
-                          dn_dr=-(dth * half_sep_m ** 2)))
+        out.append(_wrench((f, None, sign * f * half_sep_m, -dth, None,
+                            -(dth * half_sep_m ** 2))))
     return out
 
 
@@ -366,7 +377,7 @@ def lateral_resistance(w_eff_n: float, sway_mps: float, yaw_rate_rps: float,
         th = math.tanh((sway_mps + yaw_rate_rps * s_j) / v_ref)
         f = -lat_n * th - lat_c * (sway_mps + yaw_rate_rps * s_j)
         d = lat_n * (1.0 - th * th) / v_ref + lat_c
-        out.append(Wrench(y_n=f, n_nm=f * s_j, dy_dv=-d, dn_dr=-(d * s_j * s_j)))
+        out.append(_wrench((None, f, f * s_j, None, -d, -(d * s_j * s_j))))
     return out
 
 
@@ -376,15 +387,16 @@ def slope_gravity(weight_n: float, buoyancy_n: float, gradient: float, cos_yaw: 
     if gradient == 0.0:
         return []
     down = -(weight_n - buoyancy_n) * gradient / math.sqrt(1.0 + gradient * gradient)
-    return [Wrench(x_n=cos_yaw * down, y_n=-sin_yaw * down)]
+    return [_wrench((cos_yaw * down, -sin_yaw * down, None, None, None, None))]
 
 
 def propulsion(thrust_n: list[float], walk_ratio: float, prop_x_m: float,
                half_sep_m: float) -> list[Wrench]:
     """The two propellers' thrust and the sideways propeller walk."""
     walk = -walk_ratio * (thrust_n[0] + thrust_n[1])
-    return [Wrench(x_n=thrust_n[0] + thrust_n[1], n_nm=(thrust_n[1] - thrust_n[0]) * half_sep_m),
-            Wrench(y_n=walk, n_nm=walk * prop_x_m)]
+    return [_wrench((thrust_n[0] + thrust_n[1], None, (thrust_n[1] - thrust_n[0]) * half_sep_m,
+                     None, None, None)),
+            _wrench((None, walk, walk * prop_x_m, None, None, None))]
 
 
 def hydrodynamic_drag(u_rel_mps: float, v_rel_mps: float, yaw_rate_rps: float,
@@ -409,5 +421,5 @@ def hydrodynamic_drag(u_rel_mps: float, v_rel_mps: float, yaw_rate_rps: float,
 def odom_force(fx_n: float, fy_n: float, moment_nm: float, cos_yaw: float,
                sin_yaw: float) -> Wrench:
     """A horizontal force given in odom (waves, a tow line), in body axes."""
-    return Wrench(x_n=cos_yaw * fx_n + sin_yaw * fy_n, y_n=-sin_yaw * fx_n + cos_yaw * fy_n,
-                  n_nm=moment_nm)
+    return _wrench((cos_yaw * fx_n + sin_yaw * fy_n, -sin_yaw * fx_n + cos_yaw * fy_n, moment_nm,
+                    None, None, None))

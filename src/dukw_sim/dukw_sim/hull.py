@@ -27,6 +27,8 @@ from dukw_model.seakeeping import HEAVE_SECANT_M, heave_constants, oscillator_co
 
 from dukw_sim.params import SeakeepingParams
 
+_max_of = np.maximum.reduce  # ndarray.max() without its Python wrapper (same bits)
+
 @dataclass(frozen=True)
 class HullGeometry:
     """Strip stations of both hulls in base_link (port hull first), and their size."""
@@ -73,7 +75,7 @@ class HullGeometry:
         deck (``buoyancy.HullSection``, the estimator's section too).
         """
         d = depth_over_bottom_m
-        deepest = float(d.max())
+        deepest = float(_max_of(d))   # d.max(), same bits
         if deepest <= 0.0:
             return self._dry
         return self.section.area_array_m2(d, deepest)

@@ -26,8 +26,17 @@ GRAVITY_MPS2 = 9.81
 _interp = getattr(getattr(np, '_core', None), 'multiarray', np).interp
 _REACH_MARGIN_M = 1e-6     # a point's |R b| against its rounded odom x
 # np.dot, not @, for the per-step small products: the same BLAS call (same bits on these
-# contiguous float arrays) without matmul's ufunc overhead, ~0.5 us less each
-_dot = np.dot
+# contiguous float arrays) without matmul's ufunc overhead, ~0.5 us less each; and np.dot's
+# C function itself, without its Python __array_function__ dispatcher (same function, bits)
+_dot = getattr(np.dot, '_implementation', np.dot)
+# ndarray.max() / .sum() without their Python wrappers (the methods call these reductions:
+# same bits), for the per-step small arrays
+_max_of = np.maximum.reduce
+_new_tuple = tuple.__new__     # a NamedTuple from all its fields' values, without its __new__
+# np.clip's ufunc without its Python wrappers (np.clip of floats calls it; same bits as
+# np.minimum(np.maximum(x, lo), hi))
+_clip = getattr(getattr(np, '_core', None), 'umath', np).clip
+_sum_of = np.add.reduce
 _MIN_KINEMATIC_DEPTH_M = 0.05
 
 
@@ -89,7 +98,7 @@ class Beach:
 
     def heights_m(self, x_m: np.ndarray) -> np.ndarray:
         """Vectorised ``height_m``."""
-        return np.minimum(np.maximum(x_m, self.flat_start_x_m), self._floor_x) * -self._tan
+        return _clip(x_m, self.flat_start_x_m, self._floor_x) * -self._tan   # min(max()): bits
 
     def distance_along_slope_m(self, x_m: float) -> float:
         """Signed distance from the mean waterline measured along the ground, m."""
@@ -420,7 +429,9 @@ class World:
         self._rigid_odom = np.zeros(4)
         self._transfer_key: tuple[float, float] | None = None
         self._sinh_depth: float | None = None
-        self._kin_per_sinh = np.zeros((0, 4))
+        self._kin_per_sinh = np.zeros((waves.count, 4))
+        self._k_col = np.zeros((waves.count, 1))
+        self._k_by_row = self._k[:, None]
         self._points = np.zeros((0, 4))
         self._points_key = (0, 0)
         self._still_x = np.array([beach.flat_start_x_m, beach.sea_floor_x_m])
@@ -538,7 +549,7 @@ class World:
             self._reach_m = float(np.hypot(rows[:, 0], rows[:, 1]).max()) + _REACH_MARGIN_M
             self._reach_of = rows
         seaward_x = x_m - self._reach_m           # no point is nearer the beach than this
-        if self._calm or (seaward_x <= 0.0 and px[:n].max() <= 0.0):  # calm, or on the sand
+        if self._calm or (seaward_x <= 0.0 and _max_of(px[:n]) <= 0.0):  # calm, or on the sand
             kin = np.zeros(kin_points)
             return px, WaterSample(np.zeros(n), kin, kin, kin, kin)
         coef = self._rigid_coef
@@ -548,7 +559,8 @@ class World:
         phase = self._rigid_phase
         _dot(coef, self._rigid_waves, out=phase[:3])
         np.remainder(phase[2], 2.0 * math.pi, out=phase[2])
-        trig = np.cos(_dot(rows, phase))            # cos on the first n rows, then sin
+        trig = _dot(rows, phase)
+        np.cos(trig, out=trig)                      # cos on the first n rows, then sin
         # every point where the breaking cap is 1 (np.interp gives fp[-1] exactly there)
         uncapped = seaward_x >= self._cap_x[1] and self._cap[1] == 1.0
         return px, self._combine(trig, px, n, kin_points, kin_height_m, uncapped,
@@ -572,8 +584,8 @@ class World:
             return WaterSample(out[:n, 0], kin, kin, kin, kin)
         if self.second_order:
             self._add_second_order(out, n, kin_points)
-        return WaterSample(out[:n, 0], out[:kin_points, 1], out[:kin_points, 2], out[n:, 3],
-                           out[n:, 4])
+        return _new_tuple(WaterSample, (out[:n, 0], out[:kin_points, 1], out[:kin_points, 2],
+                                        out[n:, 3], out[n:, 4]))   # all fields: no __new__
 
     def _set_transfer(self, x_kin: np.ndarray, kin_height_m: float,
                       offshore: bool = False) -> None:
@@ -582,18 +594,22 @@ class World:
         np.interp giving the floor's depth exactly: kept per number of points)."""
         depth = self._offshore_depth.get(x_kin.size) if offshore else None
         if depth is None:
-            depth = float(_interp(x_kin, self._still_x, self._still_depth).sum()) / x_kin.size
+            depth = float(_sum_of(_interp(x_kin, self._still_x, self._still_depth))) / x_kin.size
             depth = max(depth, _MIN_KINEMATIC_DEPTH_M)
             if offshore:
                 self._offshore_depth[x_kin.size] = depth
         zc = min(max(kin_height_m, -depth), 0.0)
         if (zc, depth) == self._transfer_key:     # e.g. the hull above the water
             return
+        k_col = self._k_col                       # (M, 1) buffer: k d, then its sinh, cosh
         if depth != self._sinh_depth:             # e.g. off the slope: the sea floor's depth
-            self._kin_per_sinh = self._kin_weights / np.sinh(self._k * depth)[:, None]
+            np.multiply(self._k_by_row, depth, out=k_col)
+            np.sinh(k_col, out=k_col)
+            np.divide(self._kin_weights, k_col, out=self._kin_per_sinh)
             self._sinh_depth = depth
-        transfer = np.cosh(self._k * (zc + depth))
-        np.multiply(transfer[:, None], self._kin_per_sinh, out=self._weights[:, 1:5])
+        np.multiply(self._k_by_row, zc + depth, out=k_col)
+        np.cosh(k_col, out=k_col)
+        np.multiply(k_col, self._kin_per_sinh, out=self._weights[:, 1:5])
         self._transfer_key = (zc, depth)
         if self.second_order:
             limit = float(_interp(depth, self._ursell_depth, self._ursell_factor))
