@@ -310,16 +310,49 @@ def mooring_force(stiffness_n_per_m: float, damping_n_per_mps: float, offset_m: 
     return fx, fy, lever_m[0] * fy - lever_m[1] * fx
 
 
+def line_force(stiffness_n_per_m: float, damping_n_per_mps: float, length_m: float,
+               offset_m: tuple, velocity_mps: tuple, lever_m: tuple) -> tuple[float, float, float]:
+    """A line of unstretched ``length_m`` from a holder's hand to a point of the vehicle
+    (offset and velocity of the point from the hand, odom): it pulls the point towards the
+    hand with the stretch's spring and the stretching rate's damper, never pushes, and is
+    slack while shorter than its length. Returns (fx, fy, yaw moment about the centre of
+    gravity, lever = the point's odom offset from it)."""
+    distance_m = math.hypot(offset_m[0], offset_m[1])
+    if distance_m <= length_m:
+        return 0.0, 0.0, 0.0
+    ex, ey = offset_m[0] / distance_m, offset_m[1] / distance_m
+    stretch_rate = velocity_mps[0] * ex + velocity_mps[1] * ey
+    tension_n = max(stiffness_n_per_m * (distance_m - length_m)
+                    + damping_n_per_mps * stretch_rate, 0.0)
+    fx, fy = -tension_n * ex, -tension_n * ey
+    return fx, fy, lever_m[0] * fy - lever_m[1] * fx
+
+
+def mooring_anchor(moor: MooringParams, x_m: float, y_m: float,
+                   yaw_rad: float) -> tuple[float, float]:
+    """Where the restraint is held (odom), for a vehicle at this pose at the start: the
+    attachment point itself ('spring'), or the holder's hand line_holder_distance_m beyond
+    it along the hull's axis, outward from the end the line is made fast to ('line')."""
+    c, s = math.cos(yaw_rad), math.sin(yaw_rad)
+    reach = moor.attach_x_m
+    if moor.model == 'line':
+        reach += math.copysign(moor.line_holder_distance_m, moor.attach_x_m)
+    return x_m + c * reach, y_m + s * reach
+
+
 def mooring(moor: MooringParams, x_m: float, y_m: float, yaw_rad: float, u_mps: float,
             v_mps: float, r_rps: float, anchor: tuple) -> tuple[float, float, float]:
-    """The mooring line's force on a vehicle at this pose and speed (body u, v, r), with the
-    anchor where the attachment point started; (fx, fy) odom and yaw moment."""
+    """The restraint's force on a vehicle at this pose and speed (body u, v, r), held at
+    ``anchor`` (``mooring_anchor``); (fx, fy) odom and yaw moment."""
     c, s = math.cos(yaw_rad), math.sin(yaw_rad)
     lever = (c * moor.attach_x_m, s * moor.attach_x_m)
     point = (x_m + lever[0], y_m + lever[1])
     vel = (c * u_mps - s * v_mps - r_rps * lever[1], s * u_mps + c * v_mps + r_rps * lever[0])
-    return mooring_force(moor.stiffness_n_per_m, moor.damping_n_per_mps,
-                         (point[0] - anchor[0], point[1] - anchor[1]), vel, lever)
+    offset = (point[0] - anchor[0], point[1] - anchor[1])
+    if moor.model == 'line':
+        return line_force(moor.line_stiffness_n_per_m, moor.line_damping_n_per_mps,
+                          moor.line_holder_distance_m + moor.line_slack_m, offset, vel, lever)
+    return mooring_force(moor.stiffness_n_per_m, moor.damping_n_per_mps, offset, vel, lever)
 
 
 def drivetrain_friction_n(friction_n: float, track_speed_mps: float, ref_mps: float,

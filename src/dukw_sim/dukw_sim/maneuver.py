@@ -25,7 +25,7 @@ import numpy as np
 
 from dukw_common.config import ConfigError
 from dukw_sim.core import Actuation, SimCore
-from dukw_sim.forces import mooring
+from dukw_sim.forces import mooring, mooring_anchor
 from dukw_sim.truth import Medium, Truth
 
 #: CSV columns: name and how it comes from a Truth (issue 3's list first).
@@ -266,14 +266,15 @@ def drift(wave_height_m: float, duration_s: float = 60.0, wave_period_s: float |
     tether. Where the paper drifted (vehicle.md 5, issue 13: in the surf of day 1): just
     afloat over the slope, the 'sea' start (the treads start.sea_tread_clearance_m over the
     sand, ~0.8 m of water), not the 'afloat' start off the slope in 1.5 m of water, where the
-    waves' particle velocities and their change along the hulls are smaller."""
+    waves' particle velocities and their change along the hulls are smaller. The restraint:
+    ``mooring.*`` (a spring and damper to the attachment point's start, or a tension-only
+    line to a holder's hand)."""
     sim = SimCore.from_config(config, seed=seed,
                               overrides=_wave_overrides(wave_height_m, wave_period_s))
     sim.reset('sea', yaw_rad=math.pi)
     x0 = sim.x
     moor = sim.params.mooring
-    anchor = (sim.x + math.cos(sim.yaw) * moor.attach_x_m,
-              sim.y + math.sin(sim.yaw) * moor.attach_x_m)
+    anchor = mooring_anchor(moor, sim.x, sim.y, sim.yaw)
 
     def hold(s: SimCore) -> None:
         s.set_external_force(*mooring(moor, s.x, s.y, s.yaw, s.u, s.v, s.r, anchor))

@@ -13,6 +13,8 @@ from dukw_common.vehicle import SoilParams, soil_params
 
 from dukw_sim.world import SecondOrder, WaveModel
 
+MOORING_MODELS = ('spring', 'line')
+
 # Override names accepted for the shared site block (the world's beach lives there).
 SITE_ALIASES = {'world.beach_slope_rad': 'site.beach_slope_rad',
                 'world.sea_floor_depth_m': 'site.sea_floor_depth_m'}
@@ -183,15 +185,27 @@ class WaveMomentParams:
 
 @dataclass(frozen=True)
 class MooringParams:
-    """The drift test's soft restraint: a line held at the bow (a spring and a damper)."""
+    """The drift test's restraint: a spring and a damper to a fixed anchor ('spring') or a
+    line to a holder's hand that only pulls and goes slack ('line'), at attach_x_m."""
 
-    stiffness_n_per_m: float
+    model: str                           # 'spring' | 'line'
+    stiffness_n_per_m: float             # 'spring': both ways, in x and y
     damping_n_per_mps: float
     attach_x_m: float                    # where the line is made fast, base_link x, m
+    line_stiffness_n_per_m: float        # 'line': the rope and the holder's arm in series
+    line_damping_n_per_mps: float        # 'line': the holder's arm yielding
+    line_holder_distance_m: float        # 'line': hand to the attachment point at the start,
+                                         # along the hull's axis, outward, m
+    line_slack_m: float                  # 'line': unstretched length beyond that distance, m
 
     def __post_init__(self) -> None:
-        if self.stiffness_n_per_m < 0.0 or self.damping_n_per_mps < 0.0:
-            raise ConfigError('mooring stiffness and damping must be >= 0')
+        if self.model not in MOORING_MODELS:
+            raise ConfigError(f'mooring.model must be one of {MOORING_MODELS}, '
+                              f'got {self.model!r}')
+        if min(self.stiffness_n_per_m, self.damping_n_per_mps, self.line_stiffness_n_per_m,
+               self.line_damping_n_per_mps, self.line_slack_m) < 0.0:
+            raise ConfigError('mooring stiffnesses, dampings and line_slack_m must be >= 0')
+        _positive(self, 'line_holder_distance_m')
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,9 @@ import numpy as np
 import pytest
 
 from dukw_sim.core import SimCore
+from dukw_common.config import ConfigError
 from dukw_sim.forces import (Wrench, hydrodynamic_drag, lateral_resistance, mooring,
+                             mooring_anchor,
                              odom_force, propulsion, rolling_resistance, slope_gravity,
                              saturated_share, strip_basis, strip_sums, sum_wrenches,
                              surf_resistance, track_wetness, water_yaw_rate_rps, wave_moments)
@@ -197,8 +199,8 @@ def test_surf_resistance_grows_with_wetness_weight_and_waves_within_the_tow_test
 
 
 def test_mooring_pulls_back_to_the_anchor_and_turns_about_its_point():
-    moor = dataclasses.replace(PARAMS.mooring, stiffness_n_per_m=60.0, damping_n_per_mps=0.0,
-                               attach_x_m=-1.0)
+    moor = dataclasses.replace(PARAMS.mooring, model='spring', stiffness_n_per_m=60.0,
+                               damping_n_per_mps=0.0, attach_x_m=-1.0)
     anchor = (-1.0, 0.0)
     assert mooring(moor, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, anchor) == pytest.approx((0.0, 0.0, 0.0))
     fx, fy, moment = mooring(moor, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, anchor)
@@ -207,6 +209,47 @@ def test_mooring_pulls_back_to_the_anchor_and_turns_about_its_point():
     # starboard, a + yaw moment that turns the vehicle back (held at the stern: stable)
     _, fy, moment = mooring(moor, 0.0, 0.0, -0.1, 0.0, 0.0, 0.0, anchor)
     assert fy < 0.0 and moment > 0.0
+
+
+def _stern_line(**changes) -> object:
+    settings = dict(model='line', attach_x_m=-1.0, line_stiffness_n_per_m=300.0,
+                    line_damping_n_per_mps=0.0, line_holder_distance_m=1.0, line_slack_m=0.2)
+    settings.update(changes)
+    return dataclasses.replace(PARAMS.mooring, **settings)
+
+
+def test_a_line_is_held_beyond_its_end_and_is_slack_within_its_length():
+    moor = _stern_line()
+    hand = mooring_anchor(moor, 0.0, 0.0, 0.0)
+    assert hand == pytest.approx((-2.0, 0.0))             # 1 m astern of the stern fitting
+    assert mooring_anchor(_stern_line(attach_x_m=1.2), 0.0, 0.0, math.pi) == pytest.approx(
+        (-2.2, 0.0))                                      # bow line, bow to the beach
+    # within the 1.2 m line (1 m + 0.2 m slack): no force, however fast it moves
+    assert mooring(moor, 0.15, 0.0, 0.0, 1.0, 0.3, 0.2, hand) == (0.0, 0.0, 0.0)
+    assert mooring(moor, -0.5, 0.0, 0.0, -1.0, 0.0, 0.0, hand) == (0.0, 0.0, 0.0)
+
+
+def test_a_taut_line_pulls_towards_the_hand_and_never_pushes():
+    moor = _stern_line(line_damping_n_per_mps=15.0)
+    hand = mooring_anchor(moor, 0.0, 0.0, 0.0)
+    fx, fy, moment = mooring(moor, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, hand)
+    assert (fx, fy, moment) == pytest.approx((-300.0 * 0.3, 0.0, 0.0))
+    # stretching at 1 m/s adds the hand's damping; shortening fast: slack, not a push
+    assert mooring(moor, 0.5, 0.0, 0.0, 1.0, 0.0, 0.0, hand)[0] == pytest.approx(-105.0)
+    assert mooring(moor, 0.5, 0.0, 0.0, -10.0, 0.0, 0.0, hand) == (0.0, 0.0, 0.0)
+    # stern swung to port (yaw -0.1 turns the bow to starboard): the line pulls the stern
+    # back to starboard and seaward, a + yaw moment (held astern: stable)
+    fx, fy, moment = mooring(moor, 0.3, 0.0, -0.1, 0.0, 0.0, 0.0, hand)
+    assert fx < 0.0 and fy < 0.0 and moment > 0.0
+
+
+def test_mooring_settings_are_checked():
+    with pytest.raises(ConfigError, match='mooring.model'):
+        dataclasses.replace(PARAMS.mooring, model='chain')
+    with pytest.raises(ConfigError):
+        dataclasses.replace(PARAMS.mooring, line_slack_m=-0.1)
+    with pytest.raises(ConfigError):
+        dataclasses.replace(PARAMS.mooring, line_holder_distance_m=0.0)
 
 
 def _flow(vx: np.ndarray, vy: np.ndarray) -> WaterSample:

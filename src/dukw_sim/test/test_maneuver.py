@@ -6,7 +6,9 @@ import subprocess
 import sys
 
 import pytest
+import yaml
 
+from dukw_common.config import default_config_path
 from dukw_sim import maneuver
 from dukw_sim.core import SimCore
 
@@ -127,3 +129,22 @@ def test_drift_floats_in_the_surf_bow_to_the_beach():
     assert start.x_m < sim.world.beach.sea_floor_x_m            # over the slope
     assert abs(abs(start.yaw_rad) - math.pi) < 1e-9             # bow to the beach
     assert not any(t.in_ground_contact for t in run.rows[:10])  # afloat
+
+
+def test_drift_held_by_a_line_from_seaward_stays_off_the_beach_bow_first(tmp_path):
+    """Issue 13, mooring.model 'line': a person seaward of the stern holds a tension-only
+    line; the waves' mean drift keeps it taut on average, so the vehicle stays within the
+    line's reach of the hand, afloat and bow to the beach (the spring lets it 0.7 m in)."""
+    doc = yaml.safe_load(default_config_path().read_text())
+    moor = doc['sim_node']['ros__parameters']['mooring']
+    moor['model'] = 'line'
+    config = tmp_path / 'line.yaml'
+    config.write_text(yaml.safe_dump(doc))
+    held = maneuver.drift(0.28, 30.0, seed=0, config=str(config))
+    sprung = maneuver.drift(0.28, 30.0, seed=0)
+    reach_m = moor['line_holder_distance_m'] + moor['line_slack_m']
+    assert 0.0 < held.summary['mean_shoreward_offset_m'] < 0.5 * reach_m
+    assert sprung.summary['mean_shoreward_offset_m'] > held.summary['mean_shoreward_offset_m']
+    assert max(t.x_m for t in held.rows) - held.rows[0].x_m < reach_m   # never past the hand
+    assert all(abs(abs(t.yaw_rad) - math.pi) < math.radians(30.0) for t in held.rows)
+    assert sum(t.in_ground_contact for t in held.rows) < 0.05 * len(held.rows)
