@@ -52,6 +52,8 @@ NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
     ('exit_water_s', 'debounce water -> transition, s', 0.0, 60.0),
     ('enter_land_s', 'debounce transition -> land, s', 0.0, 60.0),
     ('min_dwell_s', 'a mode is kept at least this long, s', 0.0, 600.0),
+    ('ashore_dwell_s', 'TRANSITION entered from WATER is kept at least this long before '
+     'LAND (onward, not back; props stay on in LAND after a wet read), s', 0.0, 600.0),
     ('transition_track_weight', 'share of the request to the tracks in the transition',
      0.0, 1.0),
     ('transition_prop_weight', 'share of the request to the props in the transition', 0.0, 1.0),
@@ -90,6 +92,7 @@ class ModeSettings:
     exit_water_s: float
     enter_land_s: float
     min_dwell_s: float                # a mode is kept at least this long
+    ashore_dwell_s: float             # ... but WATER -> TRANSITION -> LAND after this
     transition_track_weight: float
     transition_prop_weight: float
     land_prop_hold_s: float           # LAND keeps the props this long after the last wet read
@@ -109,6 +112,8 @@ class ModeSettings:
             raise ValueError('water_enter_fraction must be below water_exit_fraction')
         if not self.transition_enter_fraction < self.land_enter_fraction:
             raise ValueError('transition_enter_fraction must be below land_enter_fraction')
+        if not 0.0 <= self.ashore_dwell_s <= self.min_dwell_s:
+            raise ValueError('ashore_dwell_s must lie in [0, min_dwell_s]')
         if not self.land_prop_hold_s >= 0.0:
             raise ValueError('land_prop_hold_s must be >= 0')
         if not self.friction_force_n < self.ground_force_n:
@@ -166,6 +171,7 @@ class ModeManager:
         self.rejected = 0
         self._forced: Mode | None = None
         self._mode = Mode.SAFE_STOP
+        self._previous = Mode.SAFE_STOP  # the mode before the current one
         self._since_s = -math.inf
         self._reason = 'waiting for inputs'
         self.changed = True
@@ -306,6 +312,7 @@ class ModeManager:
         if mode != self._mode or reason != self._reason:
             self.changed = True
         if mode != self._mode:
+            self._previous = self._mode
             self._since_s = now_s
             for debounce in (self._to_transition, self._to_water, self._from_water,
                              self._to_land):
@@ -344,7 +351,8 @@ class ModeManager:
             self._enter(mode, now_s, f'inputs fresh: {why}')
             return
         s, f = self.s, self.weight_fraction
-        dwell_done = now_s - self._since_s >= s.min_dwell_s
+        dwell_s = now_s - self._since_s
+        dwell_done = dwell_s >= s.min_dwell_s
         wet_any = self.fore_wet or self.aft_wet
         force_low = self.track_force_n <= s.friction_force_n
         if self._mode == Mode.LAND:
@@ -362,7 +370,7 @@ class ModeManager:
                 self._enter(Mode.WATER, now_s,
                             f'afloat: weight on tracks {f:.2f}, track force '
                             f'{self.track_force_n:.0f} N at friction')
-            elif dry and dwell_done:
+            elif dry and (dwell_done or self._ashore(dwell_s)):
                 self._enter(Mode.LAND, now_s, f'out of the water: sensors dry, weight on '
                                               f'tracks {f:.2f}')
         elif self._mode == Mode.WATER:
@@ -372,6 +380,15 @@ class ModeManager:
                 self._enter(Mode.TRANSITION, now_s,
                             f'tracks on the ground: weight on tracks {f:.2f}, track force '
                             f'{self.track_force_n:.0f} N')
+
+    def _ashore(self, dwell_s: float) -> bool:
+        """Coming ashore (WATER -> TRANSITION), LAND may follow after ashore_dwell_s: the
+        dwell guards against going back with each wave, and LAND here is onward, on strong
+        evidence (both sensors dry, nearly all the weight on the tracks, enter_land_s held).
+        A grounded vehicle can be left high and dry by a trough for only a second or so
+        before the next run-up; LAND keeps the props (land_prop_hold_s), so it costs no
+        thrust, and LAND's own min_dwell_s still holds it against the next wave."""
+        return self._previous == Mode.WATER and dwell_s >= self.s.ashore_dwell_s
 
     def decision(self) -> ModeDecision:
         """The current decision with its actuator weights."""
