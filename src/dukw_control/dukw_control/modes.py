@@ -44,6 +44,10 @@ NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
     ('land_enter_fraction', 'weight on tracks above this, sensors dry: land', 0.0, 1.0),
     ('water_enter_fraction', 'weight on tracks below this, force at friction: water', 0.0, 1.0),
     ('water_exit_fraction', 'weight on tracks above this afloat: transition', 0.0, 1.0),
+    ('resting_fraction', 'afloat, a mean weight on tracks above this: resting on the ground',
+     0.0, 1.0),
+    ('resting_time_constant_s', 'low-pass of the weight on tracks for resting_fraction, s',
+     0.0, 60.0),
     ('friction_force_n', 'per-track force at drivetrain friction, N', 0.0, 2000.0),
     ('ground_force_n', 'per-track force meaning ground contact afloat, N', 0.0, 2000.0),
     ('force_time_constant_s', 'low-pass of the track force, s', 0.0, 60.0),
@@ -84,6 +88,8 @@ class ModeSettings:
     land_enter_fraction: float        # back above this (and both sensors dry): on land
     water_enter_fraction: float       # below this (and force at friction): afloat
     water_exit_fraction: float        # back above this: the tracks carry weight again
+    resting_fraction: float           # or its mean above this: resting on the ground
+    resting_time_constant_s: float    # the mean's low-pass (over the waves' heave)
     friction_force_n: float           # per-track force at or below drivetrain friction
     ground_force_n: float             # per-track force that means ground contact afloat
     force_time_constant_s: float      # low-pass of the track force (intermittent contact)
@@ -114,6 +120,9 @@ class ModeSettings:
             raise ValueError('transition_enter_fraction must be below land_enter_fraction')
         if not 0.0 <= self.ashore_dwell_s <= self.min_dwell_s:
             raise ValueError('ashore_dwell_s must lie in [0, min_dwell_s]')
+        if not self.water_enter_fraction < self.resting_fraction <= self.water_exit_fraction:
+            raise ValueError('resting_fraction must lie in (water_enter_fraction, '
+                             'water_exit_fraction]')
         if not self.land_prop_hold_s >= 0.0:
             raise ValueError('land_prop_hold_s must be >= 0')
         if not self.friction_force_n < self.ground_force_n:
@@ -167,6 +176,7 @@ class ModeManager:
         self.props_in_swash = False      # LAND, yet the props still push (land_prop_hold_s)
         self.depth_valid = False
         self.weight_fraction = 1.0
+        self.mean_weight_fraction = 1.0  # low-passed (resting_time_constant_s)
         self.track_force_n = 0.0         # low-passed max of |port|, |stbd|
         self.rejected = 0
         self._forced: Mode | None = None
@@ -200,6 +210,9 @@ class ModeManager:
             self.rejected += 1
             return False
         self.weight_fraction = min(max(f, 0.0), 1.0)
+        self.mean_weight_fraction = self._low_pass(
+            self.mean_weight_fraction, self.weight_fraction, self.s.resting_time_constant_s,
+            self._stamps.get('traction'), now_s)
         self._stamps['traction'] = now_s
         return True
 
@@ -209,15 +222,21 @@ class ModeManager:
             self.rejected += 1
             return False
         force = max(abs(port_n), abs(stbd_n))
-        last = self._stamps.get('tracks/status')
-        if last is None:
-            self.track_force_n = force
-        else:
-            dt = min(max(now_s - last, 0.0), 1.0)
-            alpha = dt / (self.s.force_time_constant_s + dt) if dt > 0 else 0.0
-            self.track_force_n += alpha * (force - self.track_force_n)
+        self.track_force_n = self._low_pass(self.track_force_n, force,
+                                            self.s.force_time_constant_s,
+                                            self._stamps.get('tracks/status'), now_s)
         self._stamps['tracks/status'] = now_s
         return True
+
+    @staticmethod
+    def _low_pass(mean: float, value: float, tau_s: float, last_s: float | None,
+                  now_s: float) -> float:
+        """First-order low-pass step; the first sample sets it."""
+        if last_s is None:
+            return value
+        dt = min(max(now_s - last_s, 0.0), 1.0)
+        alpha = dt / (tau_s + dt) if dt > 0 else 0.0
+        return mean + alpha * (value - mean)
 
     def on_attitude(self, measured_s: float, now_s: float) -> None:
         """An IMU attitude sample measured at ``measured_s`` arrived at ``now_s``."""
@@ -314,6 +333,8 @@ class ModeManager:
         if mode != self._mode:
             self._previous = self._mode
             self._since_s = now_s
+            if mode == Mode.WATER:       # the mean weight counts from afloat on
+                self.mean_weight_fraction = self.weight_fraction
             for debounce in (self._to_transition, self._to_water, self._from_water,
                              self._to_land):
                 debounce.reset()
@@ -375,10 +396,12 @@ class ModeManager:
                                               f'tracks {f:.2f}')
         elif self._mode == Mode.WATER:
             grounded = self._from_water.update(
-                f > s.water_exit_fraction or self.track_force_n > s.ground_force_n, now_s)
+                f > s.water_exit_fraction or self.mean_weight_fraction > s.resting_fraction
+                or self.track_force_n > s.ground_force_n, now_s)
             if grounded and dwell_done:
                 self._enter(Mode.TRANSITION, now_s,
-                            f'tracks on the ground: weight on tracks {f:.2f}, track force '
+                            f'tracks on the ground: weight on tracks {f:.2f} (mean '
+                            f'{self.mean_weight_fraction:.2f}), track force '
                             f'{self.track_force_n:.0f} N')
 
     def _ashore(self, dwell_s: float) -> bool:

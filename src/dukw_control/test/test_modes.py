@@ -227,3 +227,34 @@ def test_an_ashore_dwell_beyond_min_dwell_is_refused(mode_settings):
     with pytest.raises(ValueError, match='ashore_dwell_s'):
         ModeSettings(**{**dataclasses.asdict(mode_settings),
                         'ashore_dwell_s': mode_settings.min_dwell_s + 1.0})
+
+
+def test_grounded_in_the_surf_with_the_tracks_off_leaves_water(mode_settings):
+    # the weight on the stopped tracks comes and goes with each wave (10-45 %), never above
+    # water_exit_fraction for exit_water_s, and no track force: its mean says resting
+    s = mode_settings
+    f = Feed(s)
+    f.run(s.min_dwell_s + 0.5, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    assert f.mm.mode == Mode.WATER
+    low, high = s.water_enter_fraction + 0.02, s.water_exit_fraction - 0.02
+    for _ in range(4):                       # a 3.6 s wave period, below the exit threshold
+        f.run(1.8, fraction=low, fore=True, aft=True, force_n=10.0)
+        f.run(1.8, fraction=high, fore=True, aft=True, force_n=10.0)
+    assert [m for m, *_ in f.modes] == [Mode.WATER, Mode.TRANSITION]
+    assert 'mean' in f.modes[-1][2]
+
+
+def test_afloat_troughs_touching_down_do_not_leave_water(mode_settings):
+    s = mode_settings
+    f = Feed(s)
+    f.run(s.min_dwell_s + 0.5, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    for _ in range(5):                       # a trough sets the tracks down 0.5 s a wave
+        f.run(0.5, fraction=s.water_exit_fraction - 0.02, fore=True, aft=True, force_n=10.0)
+        f.run(3.1, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    assert [m for m, *_ in f.modes] == [Mode.WATER]
+
+
+def test_a_resting_fraction_outside_the_hysteresis_is_refused(mode_settings):
+    with pytest.raises(ValueError, match='resting_fraction'):
+        ModeSettings(**{**dataclasses.asdict(mode_settings),
+                        'resting_fraction': mode_settings.water_exit_fraction + 0.1})
