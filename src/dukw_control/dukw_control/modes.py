@@ -44,6 +44,10 @@ NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
     ('land_enter_fraction', 'weight on tracks above this, sensors dry: land', 0.0, 1.0),
     ('water_enter_fraction', 'weight on tracks below this, force at friction: water', 0.0, 1.0),
     ('water_exit_fraction', 'weight on tracks above this afloat: transition', 0.0, 1.0),
+    ('resting_fraction', 'afloat, a mean weight on tracks above this: resting on the ground',
+     0.0, 1.0),
+    ('resting_time_constant_s', 'low-pass of the weight on tracks for resting_fraction, s',
+     0.0, 60.0),
     ('friction_force_n', 'per-track force at drivetrain friction, N', 0.0, 2000.0),
     ('ground_force_n', 'per-track force meaning ground contact afloat, N', 0.0, 2000.0),
     ('force_time_constant_s', 'low-pass of the track force, s', 0.0, 60.0),
@@ -52,6 +56,8 @@ NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
     ('exit_water_s', 'debounce water -> transition, s', 0.0, 60.0),
     ('enter_land_s', 'debounce transition -> land, s', 0.0, 60.0),
     ('min_dwell_s', 'a mode is kept at least this long, s', 0.0, 600.0),
+    ('ashore_dwell_s', 'TRANSITION entered from WATER is kept at least this long before '
+     'LAND (onward, not back; props stay on in LAND after a wet read), s', 0.0, 600.0),
     ('transition_track_weight', 'share of the request to the tracks in the transition',
      0.0, 1.0),
     ('transition_prop_weight', 'share of the request to the props in the transition', 0.0, 1.0),
@@ -82,6 +88,8 @@ class ModeSettings:
     land_enter_fraction: float        # back above this (and both sensors dry): on land
     water_enter_fraction: float       # below this (and force at friction): afloat
     water_exit_fraction: float        # back above this: the tracks carry weight again
+    resting_fraction: float           # or its mean above this: resting on the ground
+    resting_time_constant_s: float    # the mean's low-pass (over the waves' heave)
     friction_force_n: float           # per-track force at or below drivetrain friction
     ground_force_n: float             # per-track force that means ground contact afloat
     force_time_constant_s: float      # low-pass of the track force (intermittent contact)
@@ -90,6 +98,7 @@ class ModeSettings:
     exit_water_s: float
     enter_land_s: float
     min_dwell_s: float                # a mode is kept at least this long
+    ashore_dwell_s: float             # ... but WATER -> TRANSITION -> LAND after this
     transition_track_weight: float
     transition_prop_weight: float
     land_prop_hold_s: float           # LAND keeps the props this long after the last wet read
@@ -109,6 +118,11 @@ class ModeSettings:
             raise ValueError('water_enter_fraction must be below water_exit_fraction')
         if not self.transition_enter_fraction < self.land_enter_fraction:
             raise ValueError('transition_enter_fraction must be below land_enter_fraction')
+        if not 0.0 <= self.ashore_dwell_s <= self.min_dwell_s:
+            raise ValueError('ashore_dwell_s must lie in [0, min_dwell_s]')
+        if not self.water_enter_fraction < self.resting_fraction <= self.water_exit_fraction:
+            raise ValueError('resting_fraction must lie in (water_enter_fraction, '
+                             'water_exit_fraction]')
         if not self.land_prop_hold_s >= 0.0:
             raise ValueError('land_prop_hold_s must be >= 0')
         if not self.friction_force_n < self.ground_force_n:
@@ -162,10 +176,12 @@ class ModeManager:
         self.props_in_swash = False      # LAND, yet the props still push (land_prop_hold_s)
         self.depth_valid = False
         self.weight_fraction = 1.0
+        self.mean_weight_fraction = 1.0  # low-passed (resting_time_constant_s)
         self.track_force_n = 0.0         # low-passed max of |port|, |stbd|
         self.rejected = 0
         self._forced: Mode | None = None
         self._mode = Mode.SAFE_STOP
+        self._previous = Mode.SAFE_STOP  # the mode before the current one
         self._since_s = -math.inf
         self._reason = 'waiting for inputs'
         self.changed = True
@@ -194,6 +210,9 @@ class ModeManager:
             self.rejected += 1
             return False
         self.weight_fraction = min(max(f, 0.0), 1.0)
+        self.mean_weight_fraction = self._low_pass(
+            self.mean_weight_fraction, self.weight_fraction, self.s.resting_time_constant_s,
+            self._stamps.get('traction'), now_s)
         self._stamps['traction'] = now_s
         return True
 
@@ -203,15 +222,21 @@ class ModeManager:
             self.rejected += 1
             return False
         force = max(abs(port_n), abs(stbd_n))
-        last = self._stamps.get('tracks/status')
-        if last is None:
-            self.track_force_n = force
-        else:
-            dt = min(max(now_s - last, 0.0), 1.0)
-            alpha = dt / (self.s.force_time_constant_s + dt) if dt > 0 else 0.0
-            self.track_force_n += alpha * (force - self.track_force_n)
+        self.track_force_n = self._low_pass(self.track_force_n, force,
+                                            self.s.force_time_constant_s,
+                                            self._stamps.get('tracks/status'), now_s)
         self._stamps['tracks/status'] = now_s
         return True
+
+    @staticmethod
+    def _low_pass(mean: float, value: float, tau_s: float, last_s: float | None,
+                  now_s: float) -> float:
+        """First-order low-pass step; the first sample sets it."""
+        if last_s is None:
+            return value
+        dt = min(max(now_s - last_s, 0.0), 1.0)
+        alpha = dt / (tau_s + dt) if dt > 0 else 0.0
+        return mean + alpha * (value - mean)
 
     def on_attitude(self, measured_s: float, now_s: float) -> None:
         """An IMU attitude sample measured at ``measured_s`` arrived at ``now_s``."""
@@ -306,7 +331,10 @@ class ModeManager:
         if mode != self._mode or reason != self._reason:
             self.changed = True
         if mode != self._mode:
+            self._previous = self._mode
             self._since_s = now_s
+            if mode == Mode.WATER:       # the mean weight counts from afloat on
+                self.mean_weight_fraction = self.weight_fraction
             for debounce in (self._to_transition, self._to_water, self._from_water,
                              self._to_land):
                 debounce.reset()
@@ -344,7 +372,8 @@ class ModeManager:
             self._enter(mode, now_s, f'inputs fresh: {why}')
             return
         s, f = self.s, self.weight_fraction
-        dwell_done = now_s - self._since_s >= s.min_dwell_s
+        dwell_s = now_s - self._since_s
+        dwell_done = dwell_s >= s.min_dwell_s
         wet_any = self.fore_wet or self.aft_wet
         force_low = self.track_force_n <= s.friction_force_n
         if self._mode == Mode.LAND:
@@ -362,16 +391,27 @@ class ModeManager:
                 self._enter(Mode.WATER, now_s,
                             f'afloat: weight on tracks {f:.2f}, track force '
                             f'{self.track_force_n:.0f} N at friction')
-            elif dry and dwell_done:
+            elif dry and (dwell_done or self._ashore(dwell_s)):
                 self._enter(Mode.LAND, now_s, f'out of the water: sensors dry, weight on '
                                               f'tracks {f:.2f}')
         elif self._mode == Mode.WATER:
             grounded = self._from_water.update(
-                f > s.water_exit_fraction or self.track_force_n > s.ground_force_n, now_s)
+                f > s.water_exit_fraction or self.mean_weight_fraction > s.resting_fraction
+                or self.track_force_n > s.ground_force_n, now_s)
             if grounded and dwell_done:
                 self._enter(Mode.TRANSITION, now_s,
-                            f'tracks on the ground: weight on tracks {f:.2f}, track force '
+                            f'tracks on the ground: weight on tracks {f:.2f} (mean '
+                            f'{self.mean_weight_fraction:.2f}), track force '
                             f'{self.track_force_n:.0f} N')
+
+    def _ashore(self, dwell_s: float) -> bool:
+        """Coming ashore (WATER -> TRANSITION), LAND may follow after ashore_dwell_s: the
+        dwell guards against going back with each wave, and LAND here is onward, on strong
+        evidence (both sensors dry, nearly all the weight on the tracks, enter_land_s held).
+        A grounded vehicle can be left high and dry by a trough for only a second or so
+        before the next run-up; LAND keeps the props (land_prop_hold_s), so it costs no
+        thrust, and LAND's own min_dwell_s still holds it against the next wave."""
+        return self._previous == Mode.WATER and dwell_s >= self.s.ashore_dwell_s
 
     def decision(self) -> ModeDecision:
         """The current decision with its actuator weights."""

@@ -190,3 +190,71 @@ def test_dry_land_never_runs_the_props(mode_settings):
 def test_a_negative_swash_hold_is_refused(mode_settings):
     with pytest.raises(ValueError, match='land_prop_hold_s'):
         ModeSettings(**{**dataclasses.asdict(mode_settings), 'land_prop_hold_s': -1.0})
+
+
+def test_coming_ashore_land_follows_transition_without_the_dwell(mode_settings):
+    # a beached vehicle left dry by a trough right after WATER -> TRANSITION: LAND after
+    # enter_land_s, not min_dwell_s; LAND's own dwell still holds it against the next wave
+    assert mode_settings.ashore_dwell_s + mode_settings.enter_land_s + 0.5 < \
+        mode_settings.min_dwell_s
+    f = Feed(mode_settings)
+    f.run(mode_settings.min_dwell_s + 0.5, fraction=0.0, fore=True, aft=True, depth=True,
+          force_n=10.0)
+    f.run(mode_settings.exit_water_s + 0.1, fraction=0.6, fore=True, aft=True,
+          force_n=300.0)
+    assert f.mm.mode == Mode.TRANSITION
+    entered_s = f.modes[-1][1]
+    f.run(mode_settings.enter_land_s + mode_settings.ashore_dwell_s + 0.2)
+    assert [m for m, *_ in f.modes] == [Mode.WATER, Mode.TRANSITION, Mode.LAND]
+    assert f.modes[-1][1] - entered_s < mode_settings.min_dwell_s
+    f.run(mode_settings.min_dwell_s - 1.0, fraction=0.6, fore=True)   # the next run-up
+    assert f.mm.mode == Mode.LAND
+
+
+def test_back_from_land_transition_keeps_the_full_dwell(mode_settings):
+    # LAND -> TRANSITION -> LAND is going back, not onward: min_dwell_s holds
+    f = Feed(mode_settings)
+    f.run(mode_settings.min_dwell_s + 0.5)
+    f.run(0.5, fraction=0.9, fore=True)
+    assert f.mm.mode == Mode.TRANSITION
+    f.run(mode_settings.min_dwell_s - 1.0)
+    assert f.mm.mode == Mode.TRANSITION
+    f.run(1.5)
+    assert [m for m, *_ in f.modes] == [Mode.LAND, Mode.TRANSITION, Mode.LAND]
+
+
+def test_an_ashore_dwell_beyond_min_dwell_is_refused(mode_settings):
+    with pytest.raises(ValueError, match='ashore_dwell_s'):
+        ModeSettings(**{**dataclasses.asdict(mode_settings),
+                        'ashore_dwell_s': mode_settings.min_dwell_s + 1.0})
+
+
+def test_grounded_in_the_surf_with_the_tracks_off_leaves_water(mode_settings):
+    # the weight on the stopped tracks comes and goes with each wave (10-45 %), never above
+    # water_exit_fraction for exit_water_s, and no track force: its mean says resting
+    s = mode_settings
+    f = Feed(s)
+    f.run(s.min_dwell_s + 0.5, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    assert f.mm.mode == Mode.WATER
+    low, high = s.water_enter_fraction + 0.02, s.water_exit_fraction - 0.02
+    for _ in range(4):                       # a 3.6 s wave period, below the exit threshold
+        f.run(1.8, fraction=low, fore=True, aft=True, force_n=10.0)
+        f.run(1.8, fraction=high, fore=True, aft=True, force_n=10.0)
+    assert [m for m, *_ in f.modes] == [Mode.WATER, Mode.TRANSITION]
+    assert 'mean' in f.modes[-1][2]
+
+
+def test_afloat_troughs_touching_down_do_not_leave_water(mode_settings):
+    s = mode_settings
+    f = Feed(s)
+    f.run(s.min_dwell_s + 0.5, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    for _ in range(5):                       # a trough sets the tracks down 0.5 s a wave
+        f.run(0.5, fraction=s.water_exit_fraction - 0.02, fore=True, aft=True, force_n=10.0)
+        f.run(3.1, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    assert [m for m, *_ in f.modes] == [Mode.WATER]
+
+
+def test_a_resting_fraction_outside_the_hysteresis_is_refused(mode_settings):
+    with pytest.raises(ValueError, match='resting_fraction'):
+        ModeSettings(**{**dataclasses.asdict(mode_settings),
+                        'resting_fraction': mode_settings.water_exit_fraction + 0.1})
