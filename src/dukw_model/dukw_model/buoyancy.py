@@ -15,9 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from dukw_model.scalars import is_scalar
+from dukw_model.fast_numpy import clip as _clip
 
-# np.clip's ufunc without its Python wrappers (np.clip of floats calls it; same bits)
-_clip = getattr(getattr(np, '_core', None), 'umath', np).clip
 
 ArrayLike = float | np.ndarray
 

@@ -42,16 +42,13 @@ from dukw_sim.params import SimParams, apply_overrides
 from dukw_sim.truth import Medium, Truth
 from dukw_sim.world import (Beach, WaterSample, WaveModel, World, irregular_waves, no_waves,
                             regular_waves)
+from dukw_model.fast_numpy import dot as _dot, new_tuple as _new_tuple, sum_of as _sum_of
 
 __all__ = ['Actuation', 'SimCore', 'SimParams']
 
 _LAND_FRACTION = 0.02          # submerged share of the afloat volume below which: LAND
 _NEWTON_PASSES = 3             # implicit track-soil solve
 _NEWTON_TOL_MPS = 2e-4
-_sum_of = np.add.reduce        # ndarray.sum() without its Python wrapper (same bits)
-_dot = getattr(np.dot, '_implementation', np.dot)   # np.dot without its dispatcher (same bits)
-# NamedTuples of the step from all their fields' values, without their Python __new__
-_new_tuple = tuple.__new__
 _CLEAR_MARGIN_M = 1e-9          # touchdown's shortcut: clear of the sand by more than this
 
 

@@ -19,15 +19,13 @@ import numpy as np
 
 from dukw_sim.params import LandParams, MooringParams, SurfParams, WaterParams, WaveParams
 from dukw_sim.world import WaterSample
+from dukw_model.fast_numpy import (
+    clip as _clip, dot as _dot, new_tuple as _new_tuple, sum_of as _sum_of)
 
 _ROLL_EPS_MPS = 0.005          # regularisation of Coulomb rolling resistance
 _FRICTION_EPS_MPS = 0.02       # of drivetrain friction
 _BREAKAWAY_MPS = 0.05          # below this track speed the breakaway friction applies
 LATERAL_POINTS = 5             # points along each track for the lateral resistance
-# np.clip's ufunc without its Python wrappers (np.clip of floats calls it; same bits)
-_clip = getattr(getattr(np, '_core', None), 'umath', np).clip
-_sum_of = np.add.reduce      # ndarray.sum() without its Python wrapper (same bits)
-_dot = getattr(np.dot, '_implementation', np.dot)   # np.dot without its dispatcher (same bits)
 
 
 class Wrench(NamedTuple):
@@ -47,9 +45,7 @@ class Wrench(NamedTuple):
 
 
 # Wrench(x_n, y_n, n_nm, dx_du, dy_dv, dn_dr) from the six values in order (None: no part),
-# and NamedTuples from their fields' values in general, without the NamedTuple's Python
-# __new__ (a dozen terms are made every step on the sand; ~0.3 us each)
-_new_tuple = tuple.__new__
+# without the NamedTuple's Python __new__ (a dozen terms are made every step on the sand)
 _wrench = functools.partial(_new_tuple, Wrench)
 
 

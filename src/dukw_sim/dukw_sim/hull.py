@@ -26,8 +26,8 @@ from dukw_model.buoyancy import HullSection
 from dukw_model.seakeeping import HEAVE_SECANT_M, heave_constants, oscillator_constants
 
 from dukw_sim.params import SeakeepingParams
+from dukw_model.fast_numpy import max_of as _max_of
 
-_max_of = np.maximum.reduce  # ndarray.max() without its Python wrapper (same bits)
 
 @dataclass(frozen=True)
 class HullGeometry:

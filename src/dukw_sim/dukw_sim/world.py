@@ -21,22 +21,12 @@ from typing import NamedTuple
 
 import numpy as np
 
+from dukw_model.fast_numpy import (
+    clip as _clip, dot as _dot, interp as _interp, max_of as _max_of, new_tuple as _new_tuple,
+    sum_of as _sum_of)
+
 GRAVITY_MPS2 = 9.81
-# np.interp without its Python wrapper (real values: the wrapper calls this, same result)
-_interp = getattr(getattr(np, '_core', None), 'multiarray', np).interp
 _REACH_MARGIN_M = 1e-6     # a point's |R b| against its rounded odom x
-# np.dot, not @, for the per-step small products: the same BLAS call (same bits on these
-# contiguous float arrays) without matmul's ufunc overhead, ~0.5 us less each; and np.dot's
-# C function itself, without its Python __array_function__ dispatcher (same function, bits)
-_dot = getattr(np.dot, '_implementation', np.dot)
-# ndarray.max() / .sum() without their Python wrappers (the methods call these reductions:
-# same bits), for the per-step small arrays
-_max_of = np.maximum.reduce
-_new_tuple = tuple.__new__     # a NamedTuple from all its fields' values, without its __new__
-# np.clip's ufunc without its Python wrappers (np.clip of floats calls it; same bits as
-# np.minimum(np.maximum(x, lo), hi))
-_clip = getattr(getattr(np, '_core', None), 'umath', np).clip
-_sum_of = np.add.reduce
 _MIN_KINEMATIC_DEPTH_M = 0.05
 
 
