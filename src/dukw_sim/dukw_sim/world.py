@@ -96,6 +96,19 @@ class Beach:
         return x / math.cos(self.slope_rad) + (x_m - x)
 
 
+def cos_of_double_in_place(half_angle_rad: np.ndarray) -> np.ndarray:
+    """cos(2 a) of an array of half angles a, in place: (1 - t^2) / (1 + t^2) = 2 / (1 + t^2)
+    - 1 with t = tan(a), within a few 1e-16 of np.cos (absolute; an infinite t gives -1).
+    numpy's float64 tan is vectorised (about 1 ns a value here) and its cos is not (about
+    8 ns): the simulator's 38 x 24 phases a step cost 3 instead of 7.5 us."""
+    out = np.tan(half_angle_rad, out=half_angle_rad)
+    out *= out
+    out += 1.0
+    np.divide(2.0, out, out=out)
+    out -= 1.0
+    return out
+
+
 def wavenumber(omega_rps: float, depth_m: float) -> float:
     """Linear dispersion omega^2 = g k tanh(k h), solved for k by Newton's method."""
     if omega_rps <= 0.0 or depth_m <= 0.0:
@@ -407,15 +420,17 @@ class World:
         self._wavenumbers[0], self._wavenumbers[1] = waves.kx, waves.ky
         self._wavenumbers[3] = -0.5 * math.pi
         self._time_key: float | None = None
-        # sample_rigid: [kx; ky; phase; omega], its (3, 4) coefficients and the phase matrix
-        self._rigid_waves = np.vstack([waves.kx, waves.ky, waves.phase_rad, waves.omega_rps])
+        # sample_rigid: half of [kx; ky; phase; omega] (it takes the half phases, exactly half
+        # of the phases: scaling by 0.5 is exact), its (3, 4) coefficients and the phase matrix
+        self._rigid_waves = 0.5 * np.vstack([waves.kx, waves.ky, waves.phase_rad,
+                                             waves.omega_rps])
         self._rigid_coef = np.zeros((3, 4))
         self._rigid_coef[2, 2] = 1.0
         self._rigid_phase = np.zeros((4, waves.count))
         self._reach_of: np.ndarray | None = None      # sample_rigid's rows, and their reach
         self._offshore_depth: dict[int, float] = {}   # points over the sea floor: their depth
         self._reach_m = math.inf
-        self._rigid_phase[3] = -0.5 * math.pi
+        self._rigid_phase[3] = -0.25 * math.pi       # half of the sines' -pi/2
         self._rigid_odom = np.zeros(4)
         self._transfer_key: tuple[float, float] | None = None
         self._sinh_depth: float | None = None
@@ -529,7 +544,8 @@ class World:
         A point's phase k.(X + R b) + phase - omega t is b_x (R^T k)_x + b_y (R^T k)_y plus
         the body origin's phase: one (3, 4) x (4, M) product per step gives the rotated
         wavenumbers and the origin's phase, which is kept in [0, 2 pi) so that the cosines'
-        arguments stay small (a few radians over the body, not k x + omega t).
+        arguments stay small (a few radians over the body, not k x + omega t). The products
+        give half phases, whose cosines ``cos_of_double_in_place`` takes from their tangents.
         """
         odom = self._rigid_odom
         odom[0], odom[1], odom[2] = cos_yaw, -sin_yaw, x_m
@@ -548,9 +564,8 @@ class World:
         coef[2, 0], coef[2, 1], coef[2, 3] = x_m, y_m, -t_s
         phase = self._rigid_phase
         _dot(coef, self._rigid_waves, out=phase[:3])
-        np.remainder(phase[2], 2.0 * math.pi, out=phase[2])
-        trig = _dot(rows, phase)
-        np.cos(trig, out=trig)                      # cos on the first n rows, then sin
+        np.remainder(phase[2], math.pi, out=phase[2])    # half the origin phase, in [0, pi)
+        trig = cos_of_double_in_place(_dot(rows, phase))   # cos on the first n rows, then sin
         # every point where the breaking cap is 1 (np.interp gives fp[-1] exactly there)
         uncapped = seaward_x >= self._cap_x[1] and self._cap[1] == 1.0
         return px, self._combine(trig, px, n, kin_points, kin_height_m, uncapped,
