@@ -755,10 +755,14 @@ class SimCore:
         half = self._track_len / 2.0
         # the beach is monotonic in x: the ground under the tracks (the mean of its heights
         # half a track length fore and aft) is at most the higher of those at x -+ half; the
-        # lowest track point is at least base - half - half_sep: clear above it, no contact
+        # ground's pitch and roll are at most the slope's angle, so the lowest track point
+        # (below) is at least base - half min(1, |pitch| + slope) - half_sep min(1, |roll| +
+        # slope) (|sin a| <= |a|): clear above it, no contact
         beach = self.world.beach
-        if base - half - self._half_sep > max(beach.height_m(self.x - half),
-                                              beach.height_m(self.x + half)) + _CLEAR_MARGIN_M:
+        reach = half * min(1.0, abs(self.pitch) + beach.slope_rad) \
+            + self._half_sep * min(1.0, abs(self.roll) + beach.slope_rad)
+        if base - reach > max(beach.height_m(self.x - half),
+                              beach.height_m(self.x + half)) + _CLEAR_MARGIN_M:
             return
         gz, gpitch, groll, _ = self._ground_pose()
         lowest = base - half * abs(math.sin(self.pitch - gpitch)) \
