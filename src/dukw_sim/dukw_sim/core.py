@@ -217,6 +217,7 @@ class SimCore:
         self._strip_basis = strip_basis(self.hull.station_x_m, self.hull.station_y_m)
         self._strip_tilt = np.column_stack([-self.hull.station_x_m, self.hull.station_y_m])
         self._tilt_sines = np.zeros(2)
+        self._bottom_operand = np.zeros(())
         self._wave_a2 = float(np.sum(self.world.waves.amplitude_m ** 2))
         self.reset()
 
@@ -316,7 +317,9 @@ class SimCore:
         tilt = self._tilt_sines                  # (sin(pitch), sin(roll)), kept as an array
         tilt[0], tilt[1] = math.sin(pitch), math.sin(roll)
         depths = eta[:self._n_stations] - _dot(self._strip_tilt, tilt)   # dot: matmul's bits
-        depths -= z_cg + self.hull.bottom_above_cg_m
+        bottom = self._bottom_operand             # a 0-d array (fast_numpy.operand)
+        bottom[()] = z_cg + self.hull.bottom_above_cg_m
+        depths -= bottom
         return depths
 
     def _hydro(self) -> _Hydro:

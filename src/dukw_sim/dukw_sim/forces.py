@@ -20,12 +20,13 @@ import numpy as np
 from dukw_sim.params import LandParams, MooringParams, SurfParams, WaterParams, WaveParams
 from dukw_sim.world import WaterSample
 from dukw_model.fast_numpy import (
-    clip as _clip, dot as _dot, new_tuple as _new_tuple, sum_of as _sum_of)
+    clip as _clip, dot as _dot, new_tuple as _new_tuple, operand as _operand, sum_of as _sum_of)
 
 _ROLL_EPS_MPS = 0.005          # regularisation of Coulomb rolling resistance
 _FRICTION_EPS_MPS = 0.02       # of drivetrain friction
 _BREAKAWAY_MPS = 0.05          # below this track speed the breakaway friction applies
 LATERAL_POINTS = 5             # points along each track for the lateral resistance
+_ZERO, _ONE = _operand(0.0), _operand(1.0)   # per-step ufunc operands
 
 
 class Wrench(NamedTuple):
@@ -266,7 +267,7 @@ def track_wetness(water_over_ground_m: np.ndarray, track_height_m: float) -> flo
     mean of the given points along the tracks."""
     if water_over_ground_m.size == 0:
         return 0.0
-    share = _clip(water_over_ground_m / track_height_m, 0.0, 1.0)
+    share = _clip(water_over_ground_m / track_height_m, _ZERO, _ONE)
     return float(_sum_of(share)) / share.size                    # np.mean, same bits
 
 
@@ -275,7 +276,8 @@ def saturated_share(water_over_ground_m: np.ndarray) -> float:
     the sand under the tracks is saturated, 0 (dry beach) .. 1 (all under the surf)."""
     if water_over_ground_m.size == 0:
         return 0.0
-    return float(np.count_nonzero(water_over_ground_m > 0.0)) / water_over_ground_m.size
+    return float(np.count_nonzero(np.greater(water_over_ground_m, _ZERO))) \
+        / water_over_ground_m.size
 
 
 def surf_resistance(w_eff_n: float, wetness: float, wave_height_m: float, ground_mps: tuple,

@@ -23,11 +23,12 @@ import numpy as np
 
 from dukw_model.fast_numpy import (
     clip as _clip, dot as _dot, interp as _interp, max_of as _max_of, new_tuple as _new_tuple,
-    sum_of as _sum_of)
+    operand as _operand, sum_of as _sum_of)
 
 GRAVITY_MPS2 = 9.81
 _REACH_MARGIN_M = 1e-6     # a point's |R b| against its rounded odom x
 _MIN_KINEMATIC_DEPTH_M = 0.05
+_ONE, _TWO, _PI = _operand(1.0), _operand(2.0), _operand(math.pi)   # per-step ufunc operands
 
 
 class WaveModel:
@@ -66,6 +67,8 @@ class Beach:
             raise ValueError('the flat sand must start landward of the waterline (x < 0)')
         object.__setattr__(self, '_tan', math.tan(self.slope_rad))
         object.__setattr__(self, '_floor_x', self.sea_floor_depth_m / math.tan(self.slope_rad))
+        object.__setattr__(self, '_heights_operands', (   # heights_m's, as 0-d arrays
+            _operand(self.flat_start_x_m), _operand(self._floor_x), _operand(-self._tan)))
 
     @property
     def sea_floor_x_m(self) -> float:
@@ -88,7 +91,8 @@ class Beach:
 
     def heights_m(self, x_m: np.ndarray) -> np.ndarray:
         """Vectorised ``height_m``."""
-        return _clip(x_m, self.flat_start_x_m, self._floor_x) * -self._tan   # min(max()): bits
+        flat_start_x, floor_x, minus_tan = self._heights_operands
+        return np.multiply(_clip(x_m, flat_start_x, floor_x), minus_tan)   # min(max()): bits
 
     def distance_along_slope_m(self, x_m: float) -> float:
         """Signed distance from the mean waterline measured along the ground, m."""
@@ -103,9 +107,9 @@ def cos_of_double_in_place(half_angle_rad: np.ndarray) -> np.ndarray:
     8 ns): the simulator's 38 x 24 phases a step cost 3 instead of 7.5 us."""
     out = np.tan(half_angle_rad, out=half_angle_rad)
     out *= out
-    out += 1.0
-    np.divide(2.0, out, out=out)
-    out -= 1.0
+    out += _ONE
+    np.divide(_TWO, out, out=out)
+    out -= _ONE
     return out
 
 
@@ -437,6 +441,7 @@ class World:
         self._kin_per_sinh = np.zeros((waves.count, 4))
         self._k_col = np.zeros((waves.count, 1))
         self._k_by_row = self._k[:, None]
+        self._depth_operand = np.zeros(())          # d, then z + d (fast_numpy.operand)
         self._points = np.zeros((0, 4))
         self._points_key = (0, 0)
         self._still_x = np.array([beach.flat_start_x_m, beach.sea_floor_x_m])
@@ -564,7 +569,7 @@ class World:
         coef[2, 0], coef[2, 1], coef[2, 3] = x_m, y_m, -t_s
         phase = self._rigid_phase
         _dot(coef, self._rigid_waves, out=phase[:3])
-        np.remainder(phase[2], math.pi, out=phase[2])    # half the origin phase, in [0, pi)
+        np.remainder(phase[2], _PI, out=phase[2])    # half the origin phase, in [0, pi)
         trig = cos_of_double_in_place(_dot(rows, phase))   # cos on the first n rows, then sin
         # every point where the breaking cap is 1 (np.interp gives fp[-1] exactly there)
         uncapped = seaward_x >= self._cap_x[1] and self._cap[1] == 1.0
@@ -607,12 +612,15 @@ class World:
         if (zc, depth) == self._transfer_key:     # e.g. the hull above the water
             return
         k_col = self._k_col                       # (M, 1) buffer: k d, then its sinh, cosh
+        depth_operand = self._depth_operand
         if depth != self._sinh_depth:             # e.g. off the slope: the sea floor's depth
-            np.multiply(self._k_by_row, depth, out=k_col)
+            depth_operand[()] = depth
+            np.multiply(self._k_by_row, depth_operand, out=k_col)
             np.sinh(k_col, out=k_col)
             np.divide(self._kin_weights, k_col, out=self._kin_per_sinh)
             self._sinh_depth = depth
-        np.multiply(self._k_by_row, zc + depth, out=k_col)
+        depth_operand[()] = zc + depth
+        np.multiply(self._k_by_row, depth_operand, out=k_col)
         np.cosh(k_col, out=k_col)
         np.multiply(k_col, self._kin_per_sinh, out=self._weights[:, 1:5])
         self._transfer_key = (zc, depth)
