@@ -338,7 +338,18 @@ class SimCore:
         return self._hydro_val
 
     def _grounded_buoyancy(self) -> float:
-        sums = self._hydro().sums
+        """Buoyancy of the hull at the current pose (the ground's, set by the caller to see
+        whether the water would lift it), N: the surface at the strips alone (no kinematics)
+        and the strips' area sum as ``strip_sums`` gives it (the same bits as ``_hydro``)."""
+        n = self._n_stations
+        _, water = self.world.sample_rigid(self._pts_rows, self._pts_x.size, self.x, self.y,
+                                           math.cos(self.yaw), math.sin(self.yaw), self.t_s,
+                                           0.0, kinematics=False)
+        areas = self.hull.areas_m2(self._strip_depths(water.elevation_m, self.z_cg, self.pitch,
+                                                      self.roll))
+        still = np.zeros(n)                       # kinematics that do not enter the area sum
+        sums = strip_sums(areas, _new_tuple(WaterSample, (water.elevation_m, still, still,
+                                                          still, still)), self._strip_basis)
         return self._rho_g * sums.area_m2 * self.hull.strip_length_m
 
     def _float_height(self) -> float:

@@ -540,11 +540,12 @@ class World:
         return rows
 
     def sample_rigid(self, rows: np.ndarray, n: int, x_m: float, y_m: float, cos_yaw: float,
-                     sin_yaw: float, t_s: float,
-                     kin_height_m: float) -> tuple[np.ndarray, WaterSample]:
+                     sin_yaw: float, t_s: float, kin_height_m: float,
+                     kinematics: bool = True) -> tuple[np.ndarray, WaterSample]:
         """``sample`` at n points fixed in a body whose origin is at (x, y) with this heading
         (``rows`` from ``rigid_rows``; the kinematics at the rows after the n-th), and the
-        points' odom x (one value per row).
+        points' odom x (one value per row). ``kinematics`` False: the elevation at the n
+        points only (their rows alone; the same bits as with the kinematics).
 
         A point's phase k.(X + R b) + phase - omega t is b_x (R^T k)_x + b_y (R^T k)_y plus
         the body origin's phase: one (3, 4) x (4, M) product per step gives the rotated
@@ -552,13 +553,15 @@ class World:
         arguments stay small (a few radians over the body, not k x + omega t). The products
         give half phases, whose cosines ``cos_of_double_in_place`` takes from their tangents.
         """
+        if rows is not self._reach_of:            # the points' farthest reach from the origin
+            self._reach_m = float(np.hypot(rows[:, 0], rows[:, 1]).max()) + _REACH_MARGIN_M
+            self._reach_of = rows
+        if not kinematics:
+            rows = rows[:n]
         odom = self._rigid_odom
         odom[0], odom[1], odom[2] = cos_yaw, -sin_yaw, x_m
         px = _dot(rows, odom)
         kin_points = rows.shape[0] - n
-        if rows is not self._reach_of:            # the points' farthest reach from the origin
-            self._reach_m = float(np.hypot(rows[:, 0], rows[:, 1]).max()) + _REACH_MARGIN_M
-            self._reach_of = rows
         seaward_x = x_m - self._reach_m           # no point is nearer the beach than this
         if self._calm or (seaward_x <= 0.0 and _max_of(px[:n]) <= 0.0):  # calm, or on the sand
             kin = np.zeros(kin_points)
@@ -584,9 +587,7 @@ class World:
         ``offshore``: every row over the flat sea floor)."""
         if kin_points:
             self._set_transfer(row_x[:kin_points], kin_height_m, offshore)
-            out = _dot(trig, self._weights)
-        else:
-            out = trig @ self._weights[:, :1]
+        out = _dot(trig, self._weights)   # all columns: the elevation's bits with or without
         if not uncapped:
             out *= _interp(row_x, self._cap_x, self._cap)[:, None]
         if not kin_points:
