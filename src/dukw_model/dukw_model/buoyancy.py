@@ -11,11 +11,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from dukw_model.scalars import is_scalar
-from dukw_model.fast_numpy import clip as _clip
+from dukw_model.fast_numpy import clip as _clip, operand as _operand
 
 
 ArrayLike = float | np.ndarray
@@ -118,6 +119,19 @@ def cylinder_float_depth_m(displaced_volume_m3: float, radius_m: float,
     return 0.5 * (lo + hi)
 
 
+class _SectionOperands(NamedTuple):
+    """A HullSection's constants as 0-d arrays: 0, r, r^2, the float line, the segment's
+    cap min(float line, 2 r), the strut's width, the deck."""
+
+    zero: np.ndarray
+    radius: np.ndarray
+    radius_sq: np.ndarray
+    float_depth: np.ndarray
+    segment_cap: np.ndarray
+    strut_width: np.ndarray
+    top_depth: np.ndarray
+
+
 @dataclass(frozen=True)
 class HullSection:
     """Cross-section of each SWATH hull: the paper's cylinder up to the float line, then
@@ -133,6 +147,14 @@ class HullSection:
     float_depth_m: float         # water over the hull bottom afloat in calm water
     strut_width_m: float         # wall-sided width above the float line
     top_depth_m: float = math.inf   # the deck, above the hull bottom
+
+    def __post_init__(self) -> None:
+        # area_array_m2's constant operands as 0-d arrays (fast_numpy.operand)
+        r = self.radius_m
+        object.__setattr__(self, '_operands', _SectionOperands(
+            _operand(0.0), _operand(r), _operand(r * r), _operand(self.float_depth_m),
+            _operand(min(self.float_depth_m, 2.0 * r)), _operand(self.strut_width_m),
+            _operand(self.top_depth_m)))
 
     @classmethod
     def of_hulls(cls, displaced_volume_m3: float, radius_m: float, length_m: float,
@@ -168,27 +190,27 @@ class HullSection:
         division), nor does the clip of r^2 - h^2 at 0 (correctly rounded products are
         monotonic: |h| <= r gives h h <= r r).
         """
-        r = self.radius_m
+        k = self._operands
         deck = max_depth_m is None or max_depth_m > self.top_depth_m
-        d = np.minimum(depth_m, self.top_depth_m) if deck else depth_m
+        d = np.minimum(depth_m, k.top_depth) if deck else depth_m
         # the same operations on the same operands as
         # h = r - min(max(d, 0), min(float_depth, 2r));
         # r^2 acos(h / r) - h sqrt(r^2 - h^2) + strut max(d - float_depth, 0)
-        h = _clip(d, 0.0, min(self.float_depth_m, 2.0 * r))   # min(max(d, 0), ...): same bits
-        np.subtract(r, h, out=h)
-        out = h / r
+        h = _clip(d, k.zero, k.segment_cap)   # min(max(d, 0), ...): same bits
+        np.subtract(k.radius, h, out=h)
+        out = np.divide(h, k.radius)
         np.arccos(out, out=out)
-        out *= r * r
+        out *= k.radius_sq
         root = h * h
-        np.subtract(r * r, root, out=root)
+        np.subtract(k.radius_sq, root, out=root)
         np.sqrt(root, out=root)
         root *= h
         out -= root
         if max_depth_m is not None and max_depth_m <= self.float_depth_m:
             return out                        # the strut's part is +0.0 everywhere
-        strut = np.subtract(d, self.float_depth_m, out=d if deck else None)
-        np.maximum(strut, 0.0, out=strut)
-        strut *= self.strut_width_m
+        strut = np.subtract(d, k.float_depth, out=d if deck else None)
+        np.maximum(strut, k.zero, out=strut)
+        strut *= k.strut_width
         out += strut
         return out
 

@@ -217,6 +217,7 @@ class SimCore:
         self._strip_basis = strip_basis(self.hull.station_x_m, self.hull.station_y_m)
         self._strip_tilt = np.column_stack([-self.hull.station_x_m, self.hull.station_y_m])
         self._tilt_sines = np.zeros(2)
+        self._bottom_operand = np.zeros(())
         self._wave_a2 = float(np.sum(self.world.waves.amplitude_m ** 2))
         self.reset()
 
@@ -316,7 +317,9 @@ class SimCore:
         tilt = self._tilt_sines                  # (sin(pitch), sin(roll)), kept as an array
         tilt[0], tilt[1] = math.sin(pitch), math.sin(roll)
         depths = eta[:self._n_stations] - _dot(self._strip_tilt, tilt)   # dot: matmul's bits
-        depths -= z_cg + self.hull.bottom_above_cg_m
+        bottom = self._bottom_operand             # a 0-d array (fast_numpy.operand)
+        bottom[()] = z_cg + self.hull.bottom_above_cg_m
+        depths -= bottom
         return depths
 
     def _hydro(self) -> _Hydro:
@@ -335,7 +338,18 @@ class SimCore:
         return self._hydro_val
 
     def _grounded_buoyancy(self) -> float:
-        sums = self._hydro().sums
+        """Buoyancy of the hull at the current pose (the ground's, set by the caller to see
+        whether the water would lift it), N: the surface at the strips alone (no kinematics)
+        and the strips' area sum as ``strip_sums`` gives it (the same bits as ``_hydro``)."""
+        n = self._n_stations
+        _, water = self.world.sample_rigid(self._pts_rows, self._pts_x.size, self.x, self.y,
+                                           math.cos(self.yaw), math.sin(self.yaw), self.t_s,
+                                           0.0, kinematics=False)
+        areas = self.hull.areas_m2(self._strip_depths(water.elevation_m, self.z_cg, self.pitch,
+                                                      self.roll))
+        still = np.zeros(n)                       # kinematics that do not enter the area sum
+        sums = strip_sums(areas, _new_tuple(WaterSample, (water.elevation_m, still, still,
+                                                          still, still)), self._strip_basis)
         return self._rho_g * sums.area_m2 * self.hull.strip_length_m
 
     def _float_height(self) -> float:
@@ -755,10 +769,14 @@ class SimCore:
         half = self._track_len / 2.0
         # the beach is monotonic in x: the ground under the tracks (the mean of its heights
         # half a track length fore and aft) is at most the higher of those at x -+ half; the
-        # lowest track point is at least base - half - half_sep: clear above it, no contact
+        # ground's pitch and roll are at most the slope's angle, so the lowest track point
+        # (below) is at least base - half min(1, |pitch| + slope) - half_sep min(1, |roll| +
+        # slope) (|sin a| <= |a|): clear above it, no contact
         beach = self.world.beach
-        if base - half - self._half_sep > max(beach.height_m(self.x - half),
-                                              beach.height_m(self.x + half)) + _CLEAR_MARGIN_M:
+        reach = half * min(1.0, abs(self.pitch) + beach.slope_rad) \
+            + self._half_sep * min(1.0, abs(self.roll) + beach.slope_rad)
+        if base - reach > max(beach.height_m(self.x - half),
+                              beach.height_m(self.x + half)) + _CLEAR_MARGIN_M:
             return
         gz, gpitch, groll, _ = self._ground_pose()
         lowest = base - half * abs(math.sin(self.pitch - gpitch)) \

@@ -20,12 +20,13 @@ import numpy as np
 from dukw_sim.params import LandParams, MooringParams, SurfParams, WaterParams, WaveParams
 from dukw_sim.world import WaterSample
 from dukw_model.fast_numpy import (
-    clip as _clip, dot as _dot, new_tuple as _new_tuple, sum_of as _sum_of)
+    clip as _clip, dot as _dot, new_tuple as _new_tuple, operand as _operand, sum_of as _sum_of)
 
 _ROLL_EPS_MPS = 0.005          # regularisation of Coulomb rolling resistance
 _FRICTION_EPS_MPS = 0.02       # of drivetrain friction
 _BREAKAWAY_MPS = 0.05          # below this track speed the breakaway friction applies
 LATERAL_POINTS = 5             # points along each track for the lateral resistance
+_ZERO, _ONE = _operand(0.0), _operand(1.0)   # per-step ufunc operands
 
 
 class Wrench(NamedTuple):
@@ -135,9 +136,9 @@ def _sums_of(sums: StripSums | None, areas_m2: np.ndarray, water: WaterSample,
 
 
 class Immersion(NamedTuple):
-    """The hull strips in the water: their buoyancy, the volume and its afloat share."""
+    """The hull strips in the water: their buoyancy, the volume and its afloat share (each
+    strip's buoyancy is rho g l a_i; nothing asks for it, so it is not made every step)."""
 
-    strip_force_n: np.ndarray   # buoyancy of each hull strip, N
     buoyancy_n: float
     volume_m3: float
     fraction: float             # submerged share of the afloat volume, 0..1
@@ -147,12 +148,11 @@ def immersion(areas_m2: np.ndarray, strip_length_m: float, rho_g: float,
               afloat_volume_m3: float, area_sum_m2: float | None = None) -> Immersion:
     """Buoyancy of the hull strips with these immersed section areas (``area_sum_m2``:
     their sum, if the caller has it)."""
-    strip_f = rho_g * strip_length_m * areas_m2
     if area_sum_m2 is None:
         area_sum_m2 = float(areas_m2.sum())
     buoy = rho_g * strip_length_m * area_sum_m2
     volume = buoy / rho_g
-    return _new_tuple(Immersion, (strip_f, buoy, volume, min(volume / afloat_volume_m3, 1.0)))
+    return _new_tuple(Immersion, (buoy, volume, min(volume / afloat_volume_m3, 1.0)))
 
 
 class WaveForcing(NamedTuple):
@@ -267,7 +267,7 @@ def track_wetness(water_over_ground_m: np.ndarray, track_height_m: float) -> flo
     mean of the given points along the tracks."""
     if water_over_ground_m.size == 0:
         return 0.0
-    share = _clip(water_over_ground_m / track_height_m, 0.0, 1.0)
+    share = _clip(water_over_ground_m / track_height_m, _ZERO, _ONE)
     return float(_sum_of(share)) / share.size                    # np.mean, same bits
 
 
@@ -276,7 +276,8 @@ def saturated_share(water_over_ground_m: np.ndarray) -> float:
     the sand under the tracks is saturated, 0 (dry beach) .. 1 (all under the surf)."""
     if water_over_ground_m.size == 0:
         return 0.0
-    return float(np.count_nonzero(water_over_ground_m > 0.0)) / water_over_ground_m.size
+    return float(np.count_nonzero(np.greater(water_over_ground_m, _ZERO))) \
+        / water_over_ground_m.size
 
 
 def surf_resistance(w_eff_n: float, wetness: float, wave_height_m: float, ground_mps: tuple,
@@ -431,20 +432,19 @@ def propulsion(thrust_n: list[float], walk_ratio: float, prop_x_m: float,
 def hydrodynamic_drag(u_rel_mps: float, v_rel_mps: float, yaw_rate_rps: float,
                       fraction: float, wat: WaterParams) -> Wrench:
     """Linear + quadratic hull drag through the water, scaled by the submerged share."""
-    return Wrench(
-        x_n=-(wat.surge_linear_drag_n_per_mps * u_rel_mps
-              + wat.surge_quadratic_drag_n_per_mps2 * abs(u_rel_mps) * u_rel_mps) * fraction,
-        y_n=-(wat.sway_linear_drag_n_per_mps * v_rel_mps
-              + wat.sway_quadratic_drag_n_per_mps2 * abs(v_rel_mps) * v_rel_mps) * fraction,
-        n_nm=-(wat.yaw_linear_drag_nm_per_rps * yaw_rate_rps
-               + wat.yaw_quadratic_drag_nm_per_rps2 * abs(yaw_rate_rps)
-               * yaw_rate_rps) * fraction,
-        dx_du=-(wat.surge_linear_drag_n_per_mps
-                + 2.0 * wat.surge_quadratic_drag_n_per_mps2 * abs(u_rel_mps)) * fraction,
-        dy_dv=-(wat.sway_linear_drag_n_per_mps
-                + 2.0 * wat.sway_quadratic_drag_n_per_mps2 * abs(v_rel_mps)) * fraction,
-        dn_dr=-(wat.yaw_linear_drag_nm_per_rps
-                + 2.0 * wat.yaw_quadratic_drag_nm_per_rps2 * abs(yaw_rate_rps)) * fraction)
+    return _wrench((       # x_n, y_n, n_nm, dx_du, dy_dv, dn_dr
+        -(wat.surge_linear_drag_n_per_mps * u_rel_mps
+          + wat.surge_quadratic_drag_n_per_mps2 * abs(u_rel_mps) * u_rel_mps) * fraction,
+        -(wat.sway_linear_drag_n_per_mps * v_rel_mps
+          + wat.sway_quadratic_drag_n_per_mps2 * abs(v_rel_mps) * v_rel_mps) * fraction,
+        -(wat.yaw_linear_drag_nm_per_rps * yaw_rate_rps
+          + wat.yaw_quadratic_drag_nm_per_rps2 * abs(yaw_rate_rps) * yaw_rate_rps) * fraction,
+        -(wat.surge_linear_drag_n_per_mps
+          + 2.0 * wat.surge_quadratic_drag_n_per_mps2 * abs(u_rel_mps)) * fraction,
+        -(wat.sway_linear_drag_n_per_mps
+          + 2.0 * wat.sway_quadratic_drag_n_per_mps2 * abs(v_rel_mps)) * fraction,
+        -(wat.yaw_linear_drag_nm_per_rps
+          + 2.0 * wat.yaw_quadratic_drag_nm_per_rps2 * abs(yaw_rate_rps)) * fraction))
 
 
 def odom_force(fx_n: float, fy_n: float, moment_nm: float, cos_yaw: float,
