@@ -428,6 +428,14 @@ def propulsion(thrust_n: list[float], walk_ratio: float, prop_x_m: float,
             _wrench((None, walk, walk * prop_x_m, None, None, None))]
 
 
+def strip_yaw_added_inertia_kg_m2(sway_added_mass_kg: float, station_x_m: np.ndarray) -> float:
+    """Strip theory's yaw added inertia: the sway added mass spread evenly over the strips
+    times their lever arm squared, sum a22(x) x^2 dx (Newman, Marine Hydrodynamics, 1977,
+    ch. 7), kg m^2. The same added mass the strips' wave inertia force carries across the
+    hulls (``wave_moments``), so a free hull turns with the water's cross-flow gradient."""
+    return sway_added_mass_kg * float(np.mean(np.square(station_x_m)))
+
+
 def hydrodynamic_drag(u_rel_mps: float, v_rel_mps: float, yaw_rate_rps: float,
                       fraction: float, wat: WaterParams) -> Wrench:
     """Linear + quadratic hull drag through the water, scaled by the submerged share."""

@@ -122,7 +122,6 @@ class WaterParams:
     yaw_inertia_kg_m2: float
     surge_added_mass_ratio: float
     sway_added_mass_ratio: float
-    yaw_added_inertia_ratio: float
     surge_linear_drag_n_per_mps: float
     surge_quadratic_drag_n_per_mps2: float
     sway_linear_drag_n_per_mps: float

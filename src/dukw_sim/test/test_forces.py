@@ -1,7 +1,6 @@
 """dukw_sim.forces: the per-effect force terms and their one sum."""
-import math
-
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -11,8 +10,10 @@ from dukw_common.config import ConfigError
 from dukw_sim.forces import (Wrench, hydrodynamic_drag, lateral_resistance, mooring,
                              mooring_anchor,
                              odom_force, propulsion, rolling_resistance, slope_gravity,
-                             saturated_share, strip_basis, strip_sums, sum_wrenches,
-                             surf_resistance, track_wetness, water_yaw_rate_rps, wave_moments)
+                             saturated_share, strip_basis, strip_sums,
+                             strip_yaw_added_inertia_kg_m2,
+                             sum_wrenches, surf_resistance, track_wetness, water_yaw_rate_rps,
+                             wave_moments)
 from dukw_sim.world import WaterSample
 
 PARAMS = SimCore.from_config().params
@@ -352,3 +353,27 @@ def test_the_wave_moments_from_the_sums_are_the_strips_morison_forces():
     assert got.roll_nm == pytest.approx(-lever * math.fsum(f_across), rel=1e-12)
     assert got.pitch_nm == pytest.approx(lever * math.fsum(f_along), rel=1e-12)
     assert (got.extra_fx_n, got.extra_fy_n) == pytest.approx((-s * extra, c * extra), rel=1e-12)
+
+
+def test_the_yaw_added_inertia_is_the_one_the_water_turning_over_the_strips_exerts():
+    # issue 13 (drift): strip theory's yaw added inertia, sum of a22 x^2, is the added part of
+    # the Morison moment the strips feel when the water's cross-flow acceleration grows along
+    # the hulls as alpha x (a turning water body), so a free hull turns with the water
+    sim = SimCore.from_config()
+    sim.reset('afloat')
+    x, y = sim.hull.station_x_m, sim.hull.station_y_m
+    areas = sim.hull.areas_m2(np.full(x.size, sim.hull.float_depth_m))
+    rho = sim.vehicle.body.water_density_kgpm3
+    alpha = 0.3                                    # rad/s^2
+    zeros = np.zeros(x.size)
+    water = WaterSample(zeros, zeros, zeros, -alpha * y, alpha * x)
+    ratio = PARAMS.water.sway_added_mass_ratio
+    added = (wave_moments(False, areas, sim.hull.strip_length_m, water, PARAMS.waves, rho, x, y,
+                          (1.0, 0.0), 0.0, 1.0 + ratio).yaw_nm
+             - wave_moments(False, areas, sim.hull.strip_length_m, water, PARAMS.waves, rho, x,
+                            y, (1.0, 0.0), 0.0, 1.0).yaw_nm)
+    # the transverse part only (the along-hull part, -y ax, is the surge coefficient's)
+    strips = strip_yaw_added_inertia_kg_m2(ratio * sim.vehicle.body.mass_kg, x)
+    assert added / alpha == pytest.approx(strips, rel=0.03)
+    assert strip_yaw_added_inertia_kg_m2(100.0, np.array([-1.0, 1.0])) == pytest.approx(100.0)
+    assert strip_yaw_added_inertia_kg_m2(100.0, np.array([-0.5, 0.5])) == pytest.approx(25.0)
