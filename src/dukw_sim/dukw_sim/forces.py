@@ -436,22 +436,33 @@ def strip_yaw_added_inertia_kg_m2(sway_added_mass_kg: float, station_x_m: np.nda
     return sway_added_mass_kg * float(np.mean(np.square(station_x_m)))
 
 
+def yaw_linear_drag_nm_per_rps(wat: WaterParams, surge_rel_mps: float) -> float:
+    """Linear yaw damping at a surge speed through the water: the part at zero speed
+    (``yaw_linear_drag_nm_per_rps``) plus the hulls' and keels' lift, growing with the
+    forward speed (slender-body theory, N_r ~ rho U L^3: Clarke, Gedling and Hine 1983;
+    ``yaw_lift_damping_nm_s_per_m``), N m s/rad."""
+    return (wat.yaw_linear_drag_nm_per_rps
+            + wat.yaw_lift_damping_nm_s_per_m * abs(surge_rel_mps))
+
+
 def hydrodynamic_drag(u_rel_mps: float, v_rel_mps: float, yaw_rate_rps: float,
-                      fraction: float, wat: WaterParams) -> Wrench:
-    """Linear + quadratic hull drag through the water, scaled by the submerged share."""
+                      fraction: float, wat: WaterParams,
+                      yaw_linear_nm_per_rps: float) -> Wrench:
+    """Linear + quadratic hull drag through the water, scaled by the submerged share; the
+    linear yaw damping is ``yaw_linear_nm_per_rps`` (``yaw_linear_drag_nm_per_rps``)."""
     return Wrench(
         x_n=-(wat.surge_linear_drag_n_per_mps * u_rel_mps
               + wat.surge_quadratic_drag_n_per_mps2 * abs(u_rel_mps) * u_rel_mps) * fraction,
         y_n=-(wat.sway_linear_drag_n_per_mps * v_rel_mps
               + wat.sway_quadratic_drag_n_per_mps2 * abs(v_rel_mps) * v_rel_mps) * fraction,
-        n_nm=-(wat.yaw_linear_drag_nm_per_rps * yaw_rate_rps
+        n_nm=-(yaw_linear_nm_per_rps * yaw_rate_rps
                + wat.yaw_quadratic_drag_nm_per_rps2 * abs(yaw_rate_rps)
                * yaw_rate_rps) * fraction,
         dx_du=-(wat.surge_linear_drag_n_per_mps
                 + 2.0 * wat.surge_quadratic_drag_n_per_mps2 * abs(u_rel_mps)) * fraction,
         dy_dv=-(wat.sway_linear_drag_n_per_mps
                 + 2.0 * wat.sway_quadratic_drag_n_per_mps2 * abs(v_rel_mps)) * fraction,
-        dn_dr=-(wat.yaw_linear_drag_nm_per_rps
+        dn_dr=-(yaw_linear_nm_per_rps
                 + 2.0 * wat.yaw_quadratic_drag_nm_per_rps2 * abs(yaw_rate_rps)) * fraction)
 
 

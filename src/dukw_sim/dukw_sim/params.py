@@ -127,6 +127,7 @@ class WaterParams:
     sway_linear_drag_n_per_mps: float
     sway_quadratic_drag_n_per_mps2: float
     yaw_linear_drag_nm_per_rps: float
+    yaw_lift_damping_nm_s_per_m: float
     yaw_quadratic_drag_nm_per_rps2: float
     prop_walk_ratio: float
     prop_max_current_a: float

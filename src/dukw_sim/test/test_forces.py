@@ -13,7 +13,7 @@ from dukw_sim.forces import (Wrench, hydrodynamic_drag, lateral_resistance, moor
                              saturated_share, strip_basis, strip_sums,
                              strip_yaw_added_inertia_kg_m2,
                              sum_wrenches, surf_resistance, track_wetness, water_yaw_rate_rps,
-                             wave_moments)
+                             wave_moments, yaw_linear_drag_nm_per_rps)
 from dukw_sim.world import WaterSample
 
 PARAMS = SimCore.from_config().params
@@ -44,9 +44,9 @@ def test_sum_keeps_the_order_of_the_terms():
 
 
 @pytest.mark.parametrize('effect, speed_arg, force, derivative', [
-    (lambda u: [hydrodynamic_drag(u, 0.3, 0.1, 0.8, PARAMS.water)], 'u', 'x_n', 'dx_du'),
-    (lambda v: [hydrodynamic_drag(0.4, v, 0.1, 0.8, PARAMS.water)], 'v', 'y_n', 'dy_dv'),
-    (lambda r: [hydrodynamic_drag(0.4, 0.3, r, 0.8, PARAMS.water)], 'r', 'n_nm', 'dn_dr'),
+    (lambda u: [hydrodynamic_drag(u, 0.3, 0.1, 0.8, PARAMS.water, 400.0)], 'u', 'x_n', 'dx_du'),
+    (lambda v: [hydrodynamic_drag(0.4, v, 0.1, 0.8, PARAMS.water, 400.0)], 'v', 'y_n', 'dy_dv'),
+    (lambda r: [hydrodynamic_drag(0.4, 0.3, r, 0.8, PARAMS.water, 400.0)], 'r', 'n_nm', 'dn_dr'),
     (lambda v: lateral_resistance(1500.0, v, 0.2, [-0.4, 0.0, 0.4], PARAMS.land, WEIGHT_N),
      'v', 'y_n', 'dy_dv'),
     (lambda r: lateral_resistance(1500.0, 0.05, r, [-0.4, 0.0, 0.4], PARAMS.land, WEIGHT_N),
@@ -70,9 +70,9 @@ def test_rolling_resistance_opposes_motion_and_turning():
 
 
 def test_drag_opposes_the_water_relative_motion_and_vanishes_ashore():
-    drag = hydrodynamic_drag(0.8, -0.2, 0.3, 1.0, PARAMS.water)
+    drag = hydrodynamic_drag(0.8, -0.2, 0.3, 1.0, PARAMS.water, 400.0)
     assert drag.x_n < 0.0 and drag.y_n > 0.0 and drag.n_nm < 0.0
-    ashore = hydrodynamic_drag(0.8, -0.2, 0.3, 0.0, PARAMS.water)
+    ashore = hydrodynamic_drag(0.8, -0.2, 0.3, 0.0, PARAMS.water, 400.0)
     assert (ashore.x_n, ashore.y_n, ashore.n_nm) == (0.0, 0.0, 0.0)
 
 
@@ -377,3 +377,19 @@ def test_the_yaw_added_inertia_is_the_one_the_water_turning_over_the_strips_exer
     assert added / alpha == pytest.approx(strips, rel=0.03)
     assert strip_yaw_added_inertia_kg_m2(100.0, np.array([-1.0, 1.0])) == pytest.approx(100.0)
     assert strip_yaw_added_inertia_kg_m2(100.0, np.array([-0.5, 0.5])) == pytest.approx(25.0)
+
+
+def test_the_linear_yaw_damping_grows_with_the_speed_through_the_water():
+    # issue 13: under way the hulls' and keels' lift adds a part proportional to the speed
+    # (Clarke) to the zero-speed part, either way of the surge
+    wat = dataclasses.replace(PARAMS.water, yaw_linear_drag_nm_per_rps=159.0,
+                              yaw_lift_damping_nm_s_per_m=700.0)
+    assert yaw_linear_drag_nm_per_rps(wat, 0.0) == 159.0
+    assert yaw_linear_drag_nm_per_rps(wat, 1.0) == pytest.approx(859.0)
+    assert yaw_linear_drag_nm_per_rps(wat, -0.5) == yaw_linear_drag_nm_per_rps(wat, 0.5)
+    slow = hydrodynamic_drag(0.0, 0.0, 0.2, 1.0, wat, yaw_linear_drag_nm_per_rps(wat, 0.0))
+    fast = hydrodynamic_drag(1.0, 0.0, 0.2, 1.0, wat, yaw_linear_drag_nm_per_rps(wat, 1.0))
+    assert fast.n_nm < slow.n_nm < 0.0
+    # the default: no lift part, the constant the turns were calibrated with
+    assert yaw_linear_drag_nm_per_rps(PARAMS.water, 1.0) == \
+        PARAMS.water.yaw_linear_drag_nm_per_rps + PARAMS.water.yaw_lift_damping_nm_s_per_m
