@@ -33,8 +33,10 @@ from dukw_sim.forces import (LATERAL_POINTS, BodyForces, Immersion, StripSums, W
                              WaveMoments, drivetrain_friction_n, hydrodynamic_drag, immersion,
                              lateral_resistance, odom_force, paddle_wrench, propulsion,
                              rolling_resistance, saturated_share, slope_gravity, strip_basis,
-                             strip_sums, sum_wrenches, surf_resistance, track_paddle_n,
-                             track_wetness, water_yaw_rate_rps, wave_forcing, wave_moments)
+                             strip_sums, strip_yaw_added_inertia_kg_m2,
+                             sum_wrenches, surf_resistance, track_paddle_n, track_wetness,
+                             water_yaw_rate_rps, wave_forcing, wave_moments,
+                             yaw_linear_drag_nm_per_rps)
 from dukw_sim.hull import HullGeometry, Seakeeping
 from dukw_sim.land import (TrackContact, TrackLinear, linearise, motor_limited_speed,
                            predicted_speeds)
@@ -213,6 +215,9 @@ class SimCore:
             wat.surge_linear_drag_n_per_mps / wat.sway_linear_drag_n_per_mps
             if params.wave_moments.water_rotation_by_drag
             and wat.sway_linear_drag_n_per_mps > 0.0 else 1.0)
+        # yaw added inertia afloat from the hull strips (the sway added mass along them)
+        self._yaw_added_inertia = strip_yaw_added_inertia_kg_m2(
+            wat.sway_added_mass_ratio * self._mass, self.hull.station_x_m)
         # the strips' rows 1, x, y, x^2, y^2: their area-weighted sums (forces.strip_sums)
         self._strip_basis = strip_basis(self.hull.station_x_m, self.hull.station_y_m)
         self._strip_tilt = np.column_stack([-self.hull.station_x_m, self.hull.station_y_m])
@@ -546,7 +551,8 @@ class SimCore:
                                          drives.ground, self.params.surf, half,
                                          self._other_pull_n(w_eff, gravity))
         terms += propulsion(thrust, wat.prop_walk_ratio, self.params.propeller.x_m, half)
-        terms.append(hydrodynamic_drag(*rel_water, imm.fraction, wat))
+        yaw_linear = yaw_linear_drag_nm_per_rps(wat, rel_water[0])
+        terms.append(hydrodynamic_drag(*rel_water, imm.fraction, wat, yaw_linear))
         ex, ey, en = self._external
         terms.append(odom_force(waves.fx_n + ex, waves.fy_n + ey,
                                 en + wave_yaw_nm if wave_yaw_nm else en, c, s))
@@ -568,7 +574,7 @@ class SimCore:
         u0, v0, r0 = self.u, self.v, self.r
         m_x = self._mass * (1.0 + wat.surge_added_mass_ratio * frac)
         m_y = self._mass * (1.0 + wat.sway_added_mass_ratio * frac)
-        i_z = wat.yaw_inertia_kg_m2 * (1.0 + wat.yaw_added_inertia_ratio * frac)
+        i_z = wat.yaw_inertia_kg_m2 + self._yaw_added_inertia * frac
         dv = dt * (forces.y_n - m_x * u0 * r0) / (m_y - dt * forces.dy_dv)
         base = (forces.x_n + m_y * v0 * r0, forces.n_nm, m_x, i_z, forces.dx_du, forces.dn_dr)
         du, dr, new, limited = self._solve_surge_yaw(base, drives)

@@ -429,21 +429,40 @@ def propulsion(thrust_n: list[float], walk_ratio: float, prop_x_m: float,
             _wrench((None, walk, walk * prop_x_m, None, None, None))]
 
 
+def strip_yaw_added_inertia_kg_m2(sway_added_mass_kg: float, station_x_m: np.ndarray) -> float:
+    """Strip theory's yaw added inertia: the sway added mass spread evenly over the strips
+    times their lever arm squared, sum a22(x) x^2 dx (Newman, Marine Hydrodynamics, 1977,
+    ch. 7), kg m^2. The same added mass the strips' wave inertia force carries across the
+    hulls (``wave_moments``), so a free hull turns with the water's cross-flow gradient."""
+    return sway_added_mass_kg * float(np.mean(np.square(station_x_m)))
+
+
+def yaw_linear_drag_nm_per_rps(wat: WaterParams, surge_rel_mps: float) -> float:
+    """Linear yaw damping at a surge speed through the water: the part at zero speed
+    (``yaw_linear_drag_nm_per_rps``) plus the hulls' and keels' lift, growing with the
+    forward speed (slender-body theory, N_r ~ rho U L^3: Clarke, Gedling and Hine 1983;
+    ``yaw_lift_damping_nm_s_per_m``), N m s/rad."""
+    return (wat.yaw_linear_drag_nm_per_rps
+            + wat.yaw_lift_damping_nm_s_per_m * abs(surge_rel_mps))
+
+
 def hydrodynamic_drag(u_rel_mps: float, v_rel_mps: float, yaw_rate_rps: float,
-                      fraction: float, wat: WaterParams) -> Wrench:
-    """Linear + quadratic hull drag through the water, scaled by the submerged share."""
+                      fraction: float, wat: WaterParams,
+                      yaw_linear_nm_per_rps: float) -> Wrench:
+    """Linear + quadratic hull drag through the water, scaled by the submerged share; the
+    linear yaw damping is ``yaw_linear_nm_per_rps`` (``yaw_linear_drag_nm_per_rps``)."""
     return _wrench((       # x_n, y_n, n_nm, dx_du, dy_dv, dn_dr
         -(wat.surge_linear_drag_n_per_mps * u_rel_mps
           + wat.surge_quadratic_drag_n_per_mps2 * abs(u_rel_mps) * u_rel_mps) * fraction,
         -(wat.sway_linear_drag_n_per_mps * v_rel_mps
           + wat.sway_quadratic_drag_n_per_mps2 * abs(v_rel_mps) * v_rel_mps) * fraction,
-        -(wat.yaw_linear_drag_nm_per_rps * yaw_rate_rps
+        -(yaw_linear_nm_per_rps * yaw_rate_rps
           + wat.yaw_quadratic_drag_nm_per_rps2 * abs(yaw_rate_rps) * yaw_rate_rps) * fraction,
         -(wat.surge_linear_drag_n_per_mps
           + 2.0 * wat.surge_quadratic_drag_n_per_mps2 * abs(u_rel_mps)) * fraction,
         -(wat.sway_linear_drag_n_per_mps
           + 2.0 * wat.sway_quadratic_drag_n_per_mps2 * abs(v_rel_mps)) * fraction,
-        -(wat.yaw_linear_drag_nm_per_rps
+        -(yaw_linear_nm_per_rps
           + 2.0 * wat.yaw_quadratic_drag_nm_per_rps2 * abs(yaw_rate_rps)) * fraction))
 
 

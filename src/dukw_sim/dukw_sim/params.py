@@ -122,12 +122,12 @@ class WaterParams:
     yaw_inertia_kg_m2: float
     surge_added_mass_ratio: float
     sway_added_mass_ratio: float
-    yaw_added_inertia_ratio: float
     surge_linear_drag_n_per_mps: float
     surge_quadratic_drag_n_per_mps2: float
     sway_linear_drag_n_per_mps: float
     sway_quadratic_drag_n_per_mps2: float
     yaw_linear_drag_nm_per_rps: float
+    yaw_lift_damping_nm_s_per_m: float
     yaw_quadratic_drag_nm_per_rps2: float
     prop_walk_ratio: float
     prop_max_current_a: float

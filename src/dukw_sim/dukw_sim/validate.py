@@ -27,7 +27,6 @@ from dukw_common.vehicle import Vehicle
 from dukw_model import state_space
 from dukw_sim import maneuver
 from dukw_sim.core import Actuation, SimCore
-from dukw_sim.truth import Medium
 
 GROUPS = ('land_turns', 'port_bias', 'inclines', 'water_turns', 'surf_transitions', 'drift')
 REFERENCE_FILE = Path('reference') / 'paper.yaml'
@@ -181,9 +180,12 @@ def surf_force_per_track_n(run: maneuver.ManeuverRun, gain_n_per_a: float) -> fl
     the paper measured it: motor current x the drivetrain's gain (vehicle.md 3 and 6; the
     paper Kalman-filtered the currents, a mean over the window is unaffected by that). So
     it holds the drivetrain friction, the no-load current and the tracks' paddling besides
-    the soil's force, as the boat's currents did."""
+    the soil's force, as the boat's currents did. The window is the paper's words: weight
+    on the tracks and water over the sand under base_link (the middle of the tracks'
+    contact), whatever the hulls' immersion; not the truth's medium flag, whose TRANSITION
+    needs the hulls immersed and flickers with each wave at the edge of the swash."""
     forces = [0.5 * gain_n_per_a * (t.port_current_a + t.stbd_current_a) for t in run.rows
-              if t.medium == Medium.TRANSITION and t.effective_weight_n > 0.0]
+              if t.water_depth_m > 0.0 and t.effective_weight_n > 0.0]
     return float(np.mean(forces)) if forces else float('nan')
 
 

@@ -404,3 +404,15 @@ def test_full_power_climbs_out_of_the_swash_however_wet_the_sand_since_the_tow_b
         if truth.x_m < -1.0:
             break
     assert truth.x_m < -1.0, f'stuck at x = {truth.x_m:.2f} m after {truth.t_s:.0f} s'
+
+
+def test_the_rigid_yaw_inertia_is_the_pitch_inertia_the_measured_frequencies_leave():
+    # issue 13 (drift): k_zz = k_yy, and the rigid pitch inertia is what the paper's pitch
+    # frequency gives (strips' stiffness / omega^2) less strip theory's added pitch inertia,
+    # the heave added mass (from the heave frequency) spread along the strips x x^2
+    sim = SimCore.from_config()
+    sk = sim.seakeeping
+    added_pitch = ((sk.heave_mass_kg - sim.vehicle.body.mass_kg)
+                   * float(np.mean(np.square(sim.hull.station_x_m))))
+    assert sim.params.water.yaw_inertia_kg_m2 == pytest.approx(
+        sk.pitch_inertia_kg_m2 - added_pitch, rel=0.02)

@@ -1,7 +1,6 @@
 """dukw_sim.forces: the per-effect force terms and their one sum."""
-import math
-
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -11,8 +10,10 @@ from dukw_common.config import ConfigError
 from dukw_sim.forces import (Wrench, hydrodynamic_drag, lateral_resistance, mooring,
                              mooring_anchor,
                              odom_force, propulsion, rolling_resistance, slope_gravity,
-                             saturated_share, strip_basis, strip_sums, sum_wrenches,
-                             surf_resistance, track_wetness, water_yaw_rate_rps, wave_moments)
+                             saturated_share, strip_basis, strip_sums,
+                             strip_yaw_added_inertia_kg_m2,
+                             sum_wrenches, surf_resistance, track_wetness, water_yaw_rate_rps,
+                             wave_moments, yaw_linear_drag_nm_per_rps)
 from dukw_sim.world import WaterSample
 
 PARAMS = SimCore.from_config().params
@@ -43,9 +44,9 @@ def test_sum_keeps_the_order_of_the_terms():
 
 
 @pytest.mark.parametrize('effect, speed_arg, force, derivative', [
-    (lambda u: [hydrodynamic_drag(u, 0.3, 0.1, 0.8, PARAMS.water)], 'u', 'x_n', 'dx_du'),
-    (lambda v: [hydrodynamic_drag(0.4, v, 0.1, 0.8, PARAMS.water)], 'v', 'y_n', 'dy_dv'),
-    (lambda r: [hydrodynamic_drag(0.4, 0.3, r, 0.8, PARAMS.water)], 'r', 'n_nm', 'dn_dr'),
+    (lambda u: [hydrodynamic_drag(u, 0.3, 0.1, 0.8, PARAMS.water, 400.0)], 'u', 'x_n', 'dx_du'),
+    (lambda v: [hydrodynamic_drag(0.4, v, 0.1, 0.8, PARAMS.water, 400.0)], 'v', 'y_n', 'dy_dv'),
+    (lambda r: [hydrodynamic_drag(0.4, 0.3, r, 0.8, PARAMS.water, 400.0)], 'r', 'n_nm', 'dn_dr'),
     (lambda v: lateral_resistance(1500.0, v, 0.2, [-0.4, 0.0, 0.4], PARAMS.land, WEIGHT_N),
      'v', 'y_n', 'dy_dv'),
     (lambda r: lateral_resistance(1500.0, 0.05, r, [-0.4, 0.0, 0.4], PARAMS.land, WEIGHT_N),
@@ -69,9 +70,9 @@ def test_rolling_resistance_opposes_motion_and_turning():
 
 
 def test_drag_opposes_the_water_relative_motion_and_vanishes_ashore():
-    drag = hydrodynamic_drag(0.8, -0.2, 0.3, 1.0, PARAMS.water)
+    drag = hydrodynamic_drag(0.8, -0.2, 0.3, 1.0, PARAMS.water, 400.0)
     assert drag.x_n < 0.0 and drag.y_n > 0.0 and drag.n_nm < 0.0
-    ashore = hydrodynamic_drag(0.8, -0.2, 0.3, 0.0, PARAMS.water)
+    ashore = hydrodynamic_drag(0.8, -0.2, 0.3, 0.0, PARAMS.water, 400.0)
     assert (ashore.x_n, ashore.y_n, ashore.n_nm) == (0.0, 0.0, 0.0)
 
 
@@ -352,3 +353,43 @@ def test_the_wave_moments_from_the_sums_are_the_strips_morison_forces():
     assert got.roll_nm == pytest.approx(-lever * math.fsum(f_across), rel=1e-12)
     assert got.pitch_nm == pytest.approx(lever * math.fsum(f_along), rel=1e-12)
     assert (got.extra_fx_n, got.extra_fy_n) == pytest.approx((-s * extra, c * extra), rel=1e-12)
+
+
+def test_the_yaw_added_inertia_is_the_one_the_water_turning_over_the_strips_exerts():
+    # issue 13 (drift): strip theory's yaw added inertia, sum of a22 x^2, is the added part of
+    # the Morison moment the strips feel when the water's cross-flow acceleration grows along
+    # the hulls as alpha x (a turning water body), so a free hull turns with the water
+    sim = SimCore.from_config()
+    sim.reset('afloat')
+    x, y = sim.hull.station_x_m, sim.hull.station_y_m
+    areas = sim.hull.areas_m2(np.full(x.size, sim.hull.float_depth_m))
+    rho = sim.vehicle.body.water_density_kgpm3
+    alpha = 0.3                                    # rad/s^2
+    zeros = np.zeros(x.size)
+    water = WaterSample(zeros, zeros, zeros, -alpha * y, alpha * x)
+    ratio = PARAMS.water.sway_added_mass_ratio
+    added = (wave_moments(False, areas, sim.hull.strip_length_m, water, PARAMS.waves, rho, x, y,
+                          (1.0, 0.0), 0.0, 1.0 + ratio).yaw_nm
+             - wave_moments(False, areas, sim.hull.strip_length_m, water, PARAMS.waves, rho, x,
+                            y, (1.0, 0.0), 0.0, 1.0).yaw_nm)
+    # the transverse part only (the along-hull part, -y ax, is the surge coefficient's)
+    strips = strip_yaw_added_inertia_kg_m2(ratio * sim.vehicle.body.mass_kg, x)
+    assert added / alpha == pytest.approx(strips, rel=0.03)
+    assert strip_yaw_added_inertia_kg_m2(100.0, np.array([-1.0, 1.0])) == pytest.approx(100.0)
+    assert strip_yaw_added_inertia_kg_m2(100.0, np.array([-0.5, 0.5])) == pytest.approx(25.0)
+
+
+def test_the_linear_yaw_damping_grows_with_the_speed_through_the_water():
+    # issue 13: under way the hulls' and keels' lift adds a part proportional to the speed
+    # (Clarke) to the zero-speed part, either way of the surge
+    wat = dataclasses.replace(PARAMS.water, yaw_linear_drag_nm_per_rps=159.0,
+                              yaw_lift_damping_nm_s_per_m=700.0)
+    assert yaw_linear_drag_nm_per_rps(wat, 0.0) == 159.0
+    assert yaw_linear_drag_nm_per_rps(wat, 1.0) == pytest.approx(859.0)
+    assert yaw_linear_drag_nm_per_rps(wat, -0.5) == yaw_linear_drag_nm_per_rps(wat, 0.5)
+    slow = hydrodynamic_drag(0.0, 0.0, 0.2, 1.0, wat, yaw_linear_drag_nm_per_rps(wat, 0.0))
+    fast = hydrodynamic_drag(1.0, 0.0, 0.2, 1.0, wat, yaw_linear_drag_nm_per_rps(wat, 1.0))
+    assert fast.n_nm < slow.n_nm < 0.0
+    # the default: no lift part, the constant the turns were calibrated with
+    assert yaw_linear_drag_nm_per_rps(PARAMS.water, 1.0) == \
+        PARAMS.water.yaw_linear_drag_nm_per_rps + PARAMS.water.yaw_lift_damping_nm_s_per_m

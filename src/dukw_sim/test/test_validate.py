@@ -124,19 +124,19 @@ def test_water_turns_meet_the_papers_radii(capsys):
 
 def test_surf_force_is_motor_current_times_the_gain_while_the_tracks_carry_weight():
     """The paper's track force is motor current x 8.16 N/A (vehicle.md 3 and 6), not the soil
-    force: rows afloat, on land or without weight do not count."""
+    force, while the tracks carry weight in the surf: rows afloat (no weight), on dry sand
+    (no water over it) do not count; rows in the swash with the hulls dry do."""
     from dukw_sim.maneuver import ManeuverRun
-    from dukw_sim.truth import Medium
 
     class Row:
-        def __init__(self, medium, weight_n, port_a, stbd_a):
-            self.medium, self.effective_weight_n = medium, weight_n
+        def __init__(self, water_depth_m, weight_n, port_a, stbd_a):
+            self.water_depth_m, self.effective_weight_n = water_depth_m, weight_n
             self.port_current_a, self.stbd_current_a = port_a, stbd_a
             self.port_force_n = self.stbd_force_n = -1e6      # must not be used
-    run = ManeuverRun('transition', [Row(Medium.TRANSITION, 900.0, 30.0, 20.0),
-                                     Row(Medium.TRANSITION, 0.0, 99.0, 99.0),
-                                     Row(Medium.LAND, 2894.0, 99.0, 99.0),
-                                     Row(Medium.TRANSITION, 500.0, 10.0, 20.0)])
+    run = ManeuverRun('transition', [Row(0.4, 900.0, 30.0, 20.0),
+                                     Row(0.8, 0.0, 99.0, 99.0),      # afloat
+                                     Row(-0.1, 2894.0, 99.0, 99.0),  # dry sand
+                                     Row(0.05, 2800.0, 10.0, 20.0)])  # swash, hulls dry
     assert validate.surf_force_per_track_n(run, 8.16) == pytest.approx(8.16 * (25.0 + 15.0) / 2)
     assert validate.track_force_gain_n_per_a(None) == 8.16
 
