@@ -55,6 +55,8 @@ NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
     ('enter_water_s', 'debounce transition -> water, s', 0.0, 60.0),
     ('exit_water_s', 'debounce water -> transition, s', 0.0, 60.0),
     ('enter_land_s', 'debounce transition -> land, s', 0.0, 60.0),
+    ('ashore_enter_land_s', 'debounce transition -> land coming ashore (TRANSITION entered '
+     'from WATER), s', 0.0, 60.0),
     ('min_dwell_s', 'a mode is kept at least this long, s', 0.0, 600.0),
     ('ashore_dwell_s', 'TRANSITION entered from WATER is kept at least this long before '
      'LAND (onward, not back; props stay on in LAND after a wet read), s', 0.0, 600.0),
@@ -97,6 +99,7 @@ class ModeSettings:
     enter_water_s: float
     exit_water_s: float
     enter_land_s: float
+    ashore_enter_land_s: float        # ... coming ashore (TRANSITION entered from WATER)
     min_dwell_s: float                # a mode is kept at least this long
     ashore_dwell_s: float             # ... but WATER -> TRANSITION -> LAND after this
     transition_track_weight: float
@@ -120,6 +123,8 @@ class ModeSettings:
             raise ValueError('transition_enter_fraction must be below land_enter_fraction')
         if not 0.0 <= self.ashore_dwell_s <= self.min_dwell_s:
             raise ValueError('ashore_dwell_s must lie in [0, min_dwell_s]')
+        if not 0.0 <= self.ashore_enter_land_s <= self.enter_land_s:
+            raise ValueError('ashore_enter_land_s must lie in [0, enter_land_s]')
         if not self.water_enter_fraction < self.resting_fraction <= self.water_exit_fraction:
             raise ValueError('resting_fraction must lie in (water_enter_fraction, '
                              'water_exit_fraction]')
@@ -151,14 +156,15 @@ class Debounce:
         self.hold_s = hold_s
         self._since: float | None = None
 
-    def update(self, condition: bool, now_s: float) -> bool:
-        """Feed the condition at ``now_s``; return whether it has held long enough."""
+    def update(self, condition: bool, now_s: float, hold_s: float | None = None) -> bool:
+        """Feed the condition at ``now_s``; return whether it has held long enough
+        (``hold_s``, else the debounce's own)."""
         if not condition:
             self._since = None
             return False
         if self._since is None:
             self._since = now_s
-        return now_s - self._since >= self.hold_s
+        return now_s - self._since >= (self.hold_s if hold_s is None else hold_s)
 
     def reset(self) -> None:
         """Forget how long the condition has held."""
@@ -386,7 +392,9 @@ class ModeManager:
             afloat = self._to_water.update(
                 f < s.water_enter_fraction and force_low and (
                     self._depth_ok(now_s) or (self.fore_wet and self.aft_wet)), now_s)
-            dry = self._to_land.update(not wet_any and f > s.land_enter_fraction, now_s)
+            dry = self._to_land.update(
+                not wet_any and f > s.land_enter_fraction, now_s,
+                s.ashore_enter_land_s if self._previous == Mode.WATER else None)
             if afloat and dwell_done:
                 self._enter(Mode.WATER, now_s,
                             f'afloat: weight on tracks {f:.2f}, track force '

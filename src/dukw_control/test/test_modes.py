@@ -211,6 +211,38 @@ def test_coming_ashore_land_follows_transition_without_the_dwell(mode_settings):
     assert f.mm.mode == Mode.LAND
 
 
+def test_a_short_trough_coming_ashore_is_land_but_not_on_the_way_to_sea(mode_settings):
+    # issue 18: the truth's first LAND ashore is often a trough leaving the beached hulls dry
+    # for 0.25-0.75 s; with enter_land_s the mode waited for the last run-up, 3-5 s later.
+    # On the way to sea the same trough must not send it back to LAND (min_dwell_s would
+    # then hold WATER late)
+    s = mode_settings
+    assert s.ashore_enter_land_s + 0.1 < s.enter_land_s
+    trough_s = 0.5 * (s.ashore_enter_land_s + s.enter_land_s)
+    ashore = Feed(s)
+    ashore.run(s.min_dwell_s + 0.5, fraction=0.0, fore=True, aft=True, depth=True,
+               force_n=10.0)
+    ashore.run(max(s.exit_water_s, s.ashore_dwell_s) + 0.1, fraction=0.6, fore=True,
+               aft=True, force_n=300.0)
+    assert ashore.mm.mode == Mode.TRANSITION
+    ashore.run(trough_s)
+    ashore.run(0.5, fraction=0.7, fore=True)          # the next run-up
+    assert [m for m, *_ in ashore.modes] == [Mode.WATER, Mode.TRANSITION, Mode.LAND]
+    seaward = Feed(s)
+    seaward.run(s.min_dwell_s + 0.5)
+    seaward.run(s.min_dwell_s + 0.5, fraction=0.6, fore=True)
+    assert seaward.mm.mode == Mode.TRANSITION
+    seaward.run(trough_s)
+    seaward.run(0.5, fraction=0.7, fore=True)
+    assert [m for m, *_ in seaward.modes] == [Mode.LAND, Mode.TRANSITION]
+
+
+def test_an_ashore_land_debounce_beyond_enter_land_s_is_refused(mode_settings):
+    with pytest.raises(ValueError, match='ashore_enter_land_s'):
+        ModeSettings(**{**dataclasses.asdict(mode_settings),
+                        'ashore_enter_land_s': mode_settings.enter_land_s + 0.1})
+
+
 def test_back_from_land_transition_keeps_the_full_dwell(mode_settings):
     # LAND -> TRANSITION -> LAND is going back, not onward: min_dwell_s holds
     f = Feed(mode_settings)

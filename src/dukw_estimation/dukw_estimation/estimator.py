@@ -25,7 +25,8 @@ from dukw_common.readings import (DepthReading, DriveStatus, GpsFix, GpsVelocity
 from dukw_model import traction
 from dukw_estimation.contact import ContactModel, ground_speeds
 from dukw_estimation.ekf import Idx, MotionEkf, Outcome
-from dukw_estimation.motion_filter import GROUNDED_FRACTION, MotionFilter
+from dukw_estimation.motion_filter import (GROUNDED_FRACTION, TRACK_ODOMETRY_MIN_BELT_MPS,
+                                           MotionFilter)
 from dukw_estimation.samples import OdometryEstimate, TractionEstimate
 from dukw_estimation.soil_online import OnlineSoil, OnlineSoilSettings
 from dukw_estimation.settings import SENSORS, EkfSettings
@@ -73,6 +74,8 @@ class Estimator:
         """Forget everything but the counters: back to the initial covariance."""
         self.motion_filter.reset()
         self.status_ground_mps: tuple[float, float] | None = None
+        # each track's slip at the last status with a fresh GPS velocity (track odometry)
+        self.odometry_slips: tuple[float, float] | None = None
         self.contact.reset()
         self.surface.reset()
         self.online_soil.reset(self.online_soil.prior)
@@ -189,11 +192,23 @@ class Estimator:
         # both at one time (a belt spinning up at 0.6 m/s^2 gains 0.03 m/s between statuses)
         self.status_ground_mps = ground_speeds(self.ekf.x, self.vehicle.body.hull_separation_m)
         self.contact.smooth_track_forces(s)
-        if not motion.fresh('gps_vel', s.t_s) and self.contact.fraction > GROUNDED_FRACTION:
-            motion.track_odometry(s)
+        if motion.fresh('gps_vel', s.t_s):
+            self.odometry_slips = self._status_slips(s)
+        elif self.contact.fraction > GROUNDED_FRACTION:
+            motion.track_odometry(s, self.odometry_slips)
         self._learn_soil(s)
         self.surface.track_forces(self.ekf, s)
         return self._settle('tracks', Outcome.ACCEPTED)
+
+    def _status_slips(self, s: DriveStatus) -> tuple[float, float] | None:
+        """Each track's slip at this status (its belt against the ground under it then);
+        None while a belt is too slow for its slip to say the ground speed."""
+        ground = self.status_ground_mps
+        speeds = (s.port.speed_mps, s.stbd.speed_mps)
+        if ground is None or min(abs(v) for v in speeds) < TRACK_ODOMETRY_MIN_BELT_MPS:
+            return None
+        return (float(traction.slip(speeds[0], ground[0])),
+                float(traction.slip(speeds[1], ground[1])))
 
     def _learn_soil(self, s: DriveStatus) -> None:
         """On dry sand (no hull volume and no water over the tracks' patches even with the

@@ -24,6 +24,9 @@ from dukw_estimation.settings import SENSORS, EkfSettings
 
 MAX_PREDICT_STEP_S = 0.02
 GROUNDED_FRACTION = 0.5          # above this weight share the tracks drive the vehicle
+#: below this belt speed the slip's denominator is held (``traction.slip``'s 0.05 m/s):
+#: the slip then no longer says the ground speed
+TRACK_ODOMETRY_MIN_BELT_MPS = 0.05
 
 
 #: the odometry covariances (REP 105 order x y z roll pitch yaw / vx vy vz wx wy wz): what the
@@ -269,13 +272,25 @@ class MotionFilter:
                                np.eye(2) * var, self.settings.gate_gps_vel)
 
     # ------------------------------------------------------------------ tracks
-    def track_odometry(self, s: DriveStatus) -> None:
-        """GPS velocity stale on land: the tracks say roughly how fast we go."""
+    def track_odometry(self, s: DriveStatus, slips: tuple[float, float] | None) -> None:
+        """GPS velocity stale on land: the tracks say roughly how fast we go, at the slips
+        ``slips`` (port, starboard) they ran at when the GPS velocity was last fresh. On
+        sand the tracks never grip: the Wong force needs slip, 0.1-0.6 on the campaign's
+        dry beach, 1 for a vehicle stuck in the surf, so the belt speed alone overstates
+        the ground speed by slip x belt speed (issue 18: a stuck vehicle read as moving at
+        its belt speed through a GPS dropout). The soil and the load last over a dropout
+        of seconds; the waves' change of the slip is in ``noise.track_odometry_mps``.
+        Nothing without a held slip, or with a belt too slow for the slip to say the
+        ground speed (``TRACK_ODOMETRY_MIN_BELT_MPS``)."""
         st = self.settings
+        speeds = (s.port.speed_mps, s.stbd.speed_mps)
+        if slips is None or not all(math.isfinite(i) for i in slips) \
+                or min(abs(v) for v in speeds) < TRACK_ODOMETRY_MIN_BELT_MPS:
+            return
+        port, stbd = (v * (1.0 - i) for v, i in zip(speeds, slips, strict=True))
         H = np.zeros((2, N_STATES))
         H[0, Idx.U] = H[1, Idx.R] = 1.0
-        z = np.array([0.5 * (s.port.speed_mps + s.stbd.speed_mps),
-                      (s.stbd.speed_mps - s.port.speed_mps) / st.effective_track_width_m])
+        z = np.array([0.5 * (port + stbd), (stbd - port) / st.effective_track_width_m])
         var = st.track_odometry_mps ** 2
         R = np.diag([var, var / st.effective_track_width_m ** 2])
         self.ekf.update(z, self.ekf.x[[Idx.U, Idx.R]], H, R, math.inf)

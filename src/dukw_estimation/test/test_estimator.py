@@ -205,6 +205,19 @@ def test_silent_gps_is_reported_and_the_tracks_carry_the_speed():
     assert est.odometry().x_m == pytest.approx(drive.x, abs=1.0)
 
 
+def test_a_stuck_vehicle_stays_put_through_a_gps_dropout_though_its_belts_turn():
+    # issue 18 (campaign run 187): stuck in the surf, belts at 0.7 m/s, slip 1. Read at
+    # zero slip the tracks said 0.58 m/s and 1.1 m of travel after 3 s without GPS; the slip
+    # held from the last fresh GPS velocity says the vehicle does not move.
+    est = make()
+    drive = Drive(est, u=0.0, r=0.0)
+    drive.run(5.0, track_speed=(0.7, 0.7))
+    drive.run(3.0, track_speed=(0.7, 0.7), gps=False)
+    assert est.traction().port_slip == pytest.approx(1.0, abs=0.05)
+    assert abs(est.odometry().surge_mps) < 0.05
+    assert est.odometry().x_m == pytest.approx(drive.x, abs=0.1)
+
+
 def test_water_contact_corrects_a_wrong_waterline_survey():
     """Survey says the waterline is 2 m further seaward than it is; the fore sensor knows."""
     slope = VEHICLE.site.beach_slope_rad
