@@ -1,6 +1,6 @@
 """mission_node: line-of-sight waypoint guidance on ``cmd_vel`` from ``odometry/filtered``.
 
-Subscribes ``odometry/filtered`` (nav_msgs/Odometry); publishes ``cmd_vel``
+Takes the newest ``odometry/filtered`` (nav_msgs/Odometry) at each tick; publishes ``cmd_vel``
 (geometry_msgs/TwistStamped stamped with the node's clock, or Twist:
 the shared ``cmd_vel_stamped``; reliable) at ``rate_hz`` and ``mission/status``
 (std_msgs/String, one JSON object of dukw_bringup.mission.Progress, latched)
@@ -28,7 +28,7 @@ from dukw_bringup.mission import (LosGuidance, MissionState, VelocityCommand, lo
 from dukw_common.cmd_vel import CMD_VEL_STAMPED_SPEC, cmd_vel_type, make_cmd_vel
 from dukw_common.config import ConfigError
 from dukw_common.geometry import euler_from_quaternion
-from dukw_common.node_tools import (COMMAND_QOS, SENSOR_QOS, STATE_QOS, ParamSpec,
+from dukw_common.node_tools import (COMMAND_QOS, STATE_QOS, LatestSamples, ParamSpec,
                                     declare_parameters, run_node)
 
 
@@ -55,7 +55,9 @@ class MissionNode(Node):
         self.held = False
         self.cmd_pub = self.create_publisher(cmd_vel_type(self.stamped), 'cmd_vel', COMMAND_QOS)
         self.status_pub = self.create_publisher(String, 'mission/status', STATE_QOS)
-        self.create_subscription(Odometry, 'odometry/filtered', self.on_odometry, SENSOR_QOS)
+        # guidance needs the newest pose at each tick (20 Hz), not every estimate (100 Hz):
+        # taken at the tick (README "Topic contract"); its age counts from that tick
+        self.polled = LatestSamples(self, {'odometry/filtered': (Odometry, self.on_odometry)})
         self.create_subscription(String, 'mission/plan', self.on_plan, STATE_QOS)
         self.create_subscription(Bool, 'mission/hold', self.on_hold, STATE_QOS)
         self.create_timer(1.0 / float(self.params['rate_hz']), self.on_tick)
@@ -104,6 +106,7 @@ class MissionNode(Node):
 
     def on_tick(self) -> None:
         """Start when due, advance guidance, publish cmd_vel (nothing while held)."""
+        self.polled.poll()
         now = self.now_s()
         if self.held:
             return
@@ -144,6 +147,10 @@ class MissionNode(Node):
         self.publish_status()
         for publisher in (self.cmd_pub, self.status_pub):  # deliver them before exiting
             publisher.wait_for_all_acked(Duration(seconds=0.5))
+
+    def destroy_node(self) -> None:
+        self.polled.destroy()
+        super().destroy_node()
 
 
 def main(args=None) -> int:

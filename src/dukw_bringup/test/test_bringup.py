@@ -54,6 +54,15 @@ def test_both_stack_shapes_load_with_the_same_nodes(shape):
     assert '__node:=' not in ' '.join(command)          # a rename would rename them all
 
 
+@pytest.mark.parametrize('shape', ['sim', 'boat', 'sim_composed', 'boat_composed'])
+def test_every_shape_publishes_traction_at_20_hz(shape):
+    """README "Topic contract": traction's readers need 20 Hz (the mode manager decides at
+    20 Hz, the controller's stuck detection holds 3 s), in both shapes."""
+    stack = load_stack(stack_path(shape))
+    ekf = next(spec for spec in stack.nodes if 'ekf_node' in spec.node_names)
+    assert 'traction_rate_hz:=20.0' in ekf.args
+
+
 def test_the_run_overlay_puts_every_composed_node_on_sim_time(tmp_path):
     from dukw_bringup.mission import load_mission
     from dukw_bringup.run_setup import prepare_run

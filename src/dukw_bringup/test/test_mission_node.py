@@ -38,11 +38,15 @@ def test_mission_node_drives_towards_the_first_waypoint_and_stops_on_sigint(tmp_
             moving = spin_until(executor, lambda: any(c[0] > 0.5 for c in commands), 30)
             running = spin_until(executor, lambda: any(
                 s.state is MissionState.RUNNING for s in statuses), 10)
+            # the newest pose is taken at each 20 Hz tick, not delivered at 100 Hz
+            readers = {i.node_name
+                       for i in probe.get_subscriptions_info_by_topic('/odometry/filtered')}
         finally:
             code = node.stop()
             spin_until(executor, lambda: statuses[-1].state.finished
                        and commands[-1][0] == 0.0, 5)
     assert moving and running, node.stderr
+    assert readers == {'mission_node_polled'}
     first = next(s for s in statuses if s.state is MissionState.RUNNING)
     assert first.waypoint_name == 'waterline' and first.distance_m == pytest.approx(10.0)
     assert abs(commands[-1][0]) < 1e-9 and abs(commands[-1][1]) < 1e-9

@@ -40,3 +40,21 @@ def test_latched_description_and_static_frames_reach_a_late_subscriber():
     assert (fore.x, fore.z) == pytest.approx((sensors.fore_water_x_m, sensors.fore_water_z_m))
     assert frames['depth_sounder_link'].transform.translation.z == pytest.approx(
         sensors.depth_sounder_z_m)
+
+
+def test_its_own_process_takes_no_clock_under_sim_time():
+    """The node reads no clock after its one publication: under use_sim_time (every node of
+    `bringup sim` but the simulator) it must not keep a 100 Hz /clock subscription."""
+    with NodeProcess('dukw_bringup', 'robot_state_node',
+                     ['--ros-args', '-p', 'use_sim_time:=true']) as proc:
+        with ros_node('clock_probe') as (node, executor):
+            descriptions = []
+            node.create_subscription(String, 'robot_description', descriptions.append,
+                                     STATE_QOS)
+            assert spin_until(executor, lambda: descriptions, 30.0), proc.stderr
+
+            def clock_readers():
+                return [i.node_name for i in node.get_subscriptions_info_by_topic('/clock')]
+            spin_until(executor, lambda: False, 1.0)     # the graph settles
+            assert node.get_publishers_info_by_topic('/tf_static')   # its endpoints are known
+            assert 'robot_state_node' not in clock_readers()

@@ -16,12 +16,15 @@ from sensor_msgs.msg import Imu
 from dukw_common.config import ConfigError
 from dukw_common.diagnostics import Health, Level
 from dukw_common.sources import SourceWatch
-from dukw_common.node_tools import (COMMAND_QOS, STATE_QOS, ParamSpec, declare_parameters,
-                                    diagnostic_array, refuse_second_client, run_node,
-                                    subscribe_sensors)
+from dukw_common.node_tools import (COMMAND_QOS, STATE_QOS, LatestSamples, ParamSpec,
+                                    declare_parameters, diagnostic_array,
+                                    refuse_second_client, run_node, subscribe_sensors)
 from dukw_control.convert import decision_to_msg, stamp_or
 from dukw_control.modes import NODE_PARAMS, Mode, ModeDecision
 from dukw_control.runners import ModeManagerRunner
+
+#: inputs taken at the decision's rate (only their newest sample counts)
+POLLED_INPUTS = ('imu/data',)
 
 
 class ModeManagerNode(Node):
@@ -44,7 +47,11 @@ class ModeManagerNode(Node):
                        'depth': (Depth, self.on_depth), 'traction': (Traction, self.on_traction),
                        'tracks/status': (DrivetrainStatus, self.on_tracks),
                        'imu/data': (Imu, self.on_imu)}
-        subscribe_sensors(self, self.inputs, handed_topics)
+        # The IMU only says how old the attitude is, read at each 20 Hz decision: polled, not
+        # delivered at 100 Hz (README "Topic contract"); composed, it is handed over.
+        polled = {t: self.inputs[t] for t in POLLED_INPUTS if t not in handed_topics}
+        subscribe_sensors(self, self.inputs, set(handed_topics) | set(polled))
+        self.polled = LatestSamples(self, polled)
         #: called with each published decision (a composed process's direct hand-off)
         self.decision_listeners: list[Callable[[ModeDecision], None]] = []
         self.create_service(SetMode, 'set_mode', self.on_set_mode)
@@ -95,6 +102,7 @@ class ModeManagerNode(Node):
         return response
 
     def on_timer(self) -> None:
+        self.polled.poll()
         publication = self.runner.tick(self.now_s())
         if publication is None:
             return
@@ -106,6 +114,7 @@ class ModeManagerNode(Node):
             listen(decision)
 
     def publish_diagnostics(self) -> None:
+        self.polled.poll()
         now = self.now_s()
         decision = self.core.decision()
         health = Health('mode', message=f'{decision.mode.name}: {decision.reason}', values={
@@ -125,6 +134,10 @@ class ModeManagerNode(Node):
             if stale:
                 health.message += f' (forced; {stale})'
         self.diag_pub.publish(diagnostic_array(self, [health]))
+
+    def destroy_node(self) -> None:
+        self.polled.destroy()
+        super().destroy_node()
 
 
 def main(args=None) -> int:

@@ -197,3 +197,17 @@ def test_maneuver_node_waits_for_a_first_tracks_status_after_authority():
                 proc.stderr
             assert proc.alive(), proc.stderr
         assert 'stale' not in proc.stderr and 'Traceback' not in proc.stderr, proc.stderr
+
+
+
+def test_a_separate_mode_manager_takes_the_imu_at_its_decisions_not_each_sample():
+    """One process per node the IMU (only the attitude's age) is taken by the mode
+    manager's companion node that no executor spins, not delivered to it at 100 Hz."""
+    with NodeProcess('dukw_control', 'mode_manager_node') as proc:
+        with ros_node('probe_mode_manager_imu') as (node, executor):
+            def readers(topic):
+                return {i.node_name for i in node.get_subscriptions_info_by_topic(topic)}
+            assert spin_until(executor, lambda: 'mode_manager_node_polled' in readers(
+                '/imu/data'), 30.0), proc.stderr
+            assert 'mode_manager_node' not in readers('/imu/data')
+            assert 'mode_manager_node' in readers('/traction')    # delivered as before
