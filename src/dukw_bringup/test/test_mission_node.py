@@ -10,6 +10,8 @@ from dukw_common.cmd_vel import cmd_vel_type, read_cmd_vel
 from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS
 from dukw_common.testing import NodeProcess, ros_node, spin_until
 
+UNKNOWN_NODE = '_NODE_NAME_UNKNOWN_'   # rmw's name before a node's name is discovered
+
 
 @pytest.mark.ros
 @pytest.mark.parametrize('stamped', [True, False], ids=['TwistStamped', 'Twist'])
@@ -38,9 +40,15 @@ def test_mission_node_drives_towards_the_first_waypoint_and_stops_on_sigint(tmp_
             moving = spin_until(executor, lambda: any(c[0] > 0.5 for c in commands), 30)
             running = spin_until(executor, lambda: any(
                 s.state is MissionState.RUNNING for s in statuses), 10)
-            # the newest pose is taken at each 20 Hz tick, not delivered at 100 Hz
-            readers = {i.node_name
-                       for i in probe.get_subscriptions_info_by_topic('/odometry/filtered')}
+            # the newest pose is taken at each 20 Hz tick, not delivered at 100 Hz; a remote
+            # endpoint's node name can be discovered after the endpoint: wait for the name
+
+            def odometry_readers():
+                return {i.node_name
+                        for i in probe.get_subscriptions_info_by_topic('/odometry/filtered')}
+            spin_until(executor, lambda: odometry_readers()
+                       and UNKNOWN_NODE not in odometry_readers(), 10)
+            readers = odometry_readers()
         finally:
             code = node.stop()
             spin_until(executor, lambda: statuses[-1].state.finished

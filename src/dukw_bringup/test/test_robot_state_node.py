@@ -56,5 +56,7 @@ def test_its_own_process_takes_no_clock_under_sim_time():
             def clock_readers():
                 return [i.node_name for i in node.get_subscriptions_info_by_topic('/clock')]
             spin_until(executor, lambda: False, 1.0)     # the graph settles
+            # a remote endpoint's node name can be discovered after the endpoint
+            spin_until(executor, lambda: '_NODE_NAME_UNKNOWN_' not in clock_readers(), 10.0)
             assert node.get_publishers_info_by_topic('/tf_static')   # its endpoints are known
             assert 'robot_state_node' not in clock_readers()
