@@ -35,8 +35,7 @@ from dukw_sim.forces import (LATERAL_POINTS, BodyForces, Immersion, StripSums, W
                              rolling_resistance, saturated_share, slope_gravity, strip_basis,
                              strip_sums, strip_yaw_added_inertia_kg_m2,
                              sum_wrenches, surf_resistance, track_paddle_n, track_wetness,
-                             water_yaw_rate_rps, wave_forcing, wave_moments,
-                             yaw_linear_drag_nm_per_rps)
+                             water_yaw_rate_rps, wave_forcing, wave_moments)
 from dukw_sim.hull import HullGeometry, Seakeeping
 from dukw_sim.land import (TrackContact, TrackLinear, linearise, motor_limited_speed,
                            predicted_speeds)
@@ -551,8 +550,7 @@ class SimCore:
                                          drives.ground, self.params.surf, half,
                                          self._other_pull_n(w_eff, gravity))
         terms += propulsion(thrust, wat.prop_walk_ratio, self.params.propeller.x_m, half)
-        yaw_linear = yaw_linear_drag_nm_per_rps(wat, rel_water[0])
-        terms.append(hydrodynamic_drag(*rel_water, imm.fraction, wat, yaw_linear))
+        terms.append(hydrodynamic_drag(*rel_water, imm.fraction, wat))
         ex, ey, en = self._external
         terms.append(odom_force(waves.fx_n + ex, waves.fy_n + ey,
                                 en + wave_yaw_nm if wave_yaw_nm else en, c, s))

@@ -447,10 +447,10 @@ def yaw_linear_drag_nm_per_rps(wat: WaterParams, surge_rel_mps: float) -> float:
 
 
 def hydrodynamic_drag(u_rel_mps: float, v_rel_mps: float, yaw_rate_rps: float,
-                      fraction: float, wat: WaterParams,
-                      yaw_linear_nm_per_rps: float) -> Wrench:
+                      fraction: float, wat: WaterParams) -> Wrench:
     """Linear + quadratic hull drag through the water, scaled by the submerged share; the
-    linear yaw damping is ``yaw_linear_nm_per_rps`` (``yaw_linear_drag_nm_per_rps``)."""
+    linear yaw damping grows with the surge speed (``yaw_linear_drag_nm_per_rps``)."""
+    yaw_linear_nm_per_rps = yaw_linear_drag_nm_per_rps(wat, u_rel_mps)
     return _wrench((       # x_n, y_n, n_nm, dx_du, dy_dv, dn_dr
         -(wat.surge_linear_drag_n_per_mps * u_rel_mps
           + wat.surge_quadratic_drag_n_per_mps2 * abs(u_rel_mps) * u_rel_mps) * fraction,

@@ -416,3 +416,13 @@ def test_the_rigid_yaw_inertia_is_the_pitch_inertia_the_measured_frequencies_lea
                    * float(np.mean(np.square(sim.hull.station_x_m))))
     assert sim.params.water.yaw_inertia_kg_m2 == pytest.approx(
         sk.pitch_inertia_kg_m2 - added_pitch, rel=0.02)
+
+
+def test_the_zero_speed_yaw_damping_is_the_strips_cross_flow_drag():
+    # issue 13 (drift): turning in place, each hull strip's linear sway drag acts at its
+    # lever arm: sway drag x the strips' mean x^2 (config: 159 N m s/rad, rounded)
+    sim = SimCore.from_config()
+    wat = sim.params.water
+    assert wat.yaw_linear_drag_nm_per_rps == pytest.approx(
+        wat.sway_linear_drag_n_per_mps * float(np.mean(np.square(sim.hull.station_x_m))),
+        rel=0.01)

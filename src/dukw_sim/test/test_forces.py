@@ -44,9 +44,9 @@ def test_sum_keeps_the_order_of_the_terms():
 
 
 @pytest.mark.parametrize('effect, speed_arg, force, derivative', [
-    (lambda u: [hydrodynamic_drag(u, 0.3, 0.1, 0.8, PARAMS.water, 400.0)], 'u', 'x_n', 'dx_du'),
-    (lambda v: [hydrodynamic_drag(0.4, v, 0.1, 0.8, PARAMS.water, 400.0)], 'v', 'y_n', 'dy_dv'),
-    (lambda r: [hydrodynamic_drag(0.4, 0.3, r, 0.8, PARAMS.water, 400.0)], 'r', 'n_nm', 'dn_dr'),
+    (lambda u: [hydrodynamic_drag(u, 0.3, 0.1, 0.8, PARAMS.water)], 'u', 'x_n', 'dx_du'),
+    (lambda v: [hydrodynamic_drag(0.4, v, 0.1, 0.8, PARAMS.water)], 'v', 'y_n', 'dy_dv'),
+    (lambda r: [hydrodynamic_drag(0.4, 0.3, r, 0.8, PARAMS.water)], 'r', 'n_nm', 'dn_dr'),
     (lambda v: lateral_resistance(1500.0, v, 0.2, [-0.4, 0.0, 0.4], PARAMS.land, WEIGHT_N),
      'v', 'y_n', 'dy_dv'),
     (lambda r: lateral_resistance(1500.0, 0.05, r, [-0.4, 0.0, 0.4], PARAMS.land, WEIGHT_N),
@@ -70,9 +70,9 @@ def test_rolling_resistance_opposes_motion_and_turning():
 
 
 def test_drag_opposes_the_water_relative_motion_and_vanishes_ashore():
-    drag = hydrodynamic_drag(0.8, -0.2, 0.3, 1.0, PARAMS.water, 400.0)
+    drag = hydrodynamic_drag(0.8, -0.2, 0.3, 1.0, PARAMS.water)
     assert drag.x_n < 0.0 and drag.y_n > 0.0 and drag.n_nm < 0.0
-    ashore = hydrodynamic_drag(0.8, -0.2, 0.3, 0.0, PARAMS.water, 400.0)
+    ashore = hydrodynamic_drag(0.8, -0.2, 0.3, 0.0, PARAMS.water)
     assert (ashore.x_n, ashore.y_n, ashore.n_nm) == (0.0, 0.0, 0.0)
 
 
@@ -387,9 +387,9 @@ def test_the_linear_yaw_damping_grows_with_the_speed_through_the_water():
     assert yaw_linear_drag_nm_per_rps(wat, 0.0) == 159.0
     assert yaw_linear_drag_nm_per_rps(wat, 1.0) == pytest.approx(859.0)
     assert yaw_linear_drag_nm_per_rps(wat, -0.5) == yaw_linear_drag_nm_per_rps(wat, 0.5)
-    slow = hydrodynamic_drag(0.0, 0.0, 0.2, 1.0, wat, yaw_linear_drag_nm_per_rps(wat, 0.0))
-    fast = hydrodynamic_drag(1.0, 0.0, 0.2, 1.0, wat, yaw_linear_drag_nm_per_rps(wat, 1.0))
+    slow = hydrodynamic_drag(0.0, 0.0, 0.2, 1.0, wat)
+    fast = hydrodynamic_drag(1.0, 0.0, 0.2, 1.0, wat)
     assert fast.n_nm < slow.n_nm < 0.0
-    # the default: no lift part, the constant the turns were calibrated with
+    # the default: the zero-speed part plus the lift the turns were calibrated with
     assert yaw_linear_drag_nm_per_rps(PARAMS.water, 1.0) == \
         PARAMS.water.yaw_linear_drag_nm_per_rps + PARAMS.water.yaw_lift_damping_nm_s_per_m
