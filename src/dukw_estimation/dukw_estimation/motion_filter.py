@@ -15,6 +15,7 @@ import numpy as np
 
 from dukw_common.geometry import local_enu_from_geodetic, wrap_angle
 from dukw_common.vehicle import Vehicle
+from dukw_model import traction
 from dukw_model.lever_arm import (base_from_sensor_point, lever_arm_enu,
                                   sensor_point_velocity_body, specific_force_at_base)
 from dukw_estimation.ekf import N_STATES, Idx, MotionEkf, Outcome, ProcessNoise
@@ -24,9 +25,9 @@ from dukw_estimation.settings import SENSORS, EkfSettings
 
 MAX_PREDICT_STEP_S = 0.02
 GROUNDED_FRACTION = 0.5          # above this weight share the tracks drive the vehicle
-#: below this belt speed the slip's denominator is held (``traction.slip``'s 0.05 m/s):
-#: the slip then no longer says the ground speed
-TRACK_ODOMETRY_MIN_BELT_MPS = 0.05
+#: below this belt speed the slip's denominator is held (``traction.slip``): the slip then
+#: no longer says the ground speed
+TRACK_ODOMETRY_MIN_BELT_MPS = traction.MIN_TRACK_SPEED_MPS
 
 
 #: the odometry covariances (REP 105 order x y z roll pitch yaw / vx vy vz wx wy wz): what the

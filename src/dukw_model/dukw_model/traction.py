@@ -26,7 +26,7 @@ from dukw_common.vehicle import SaturatedSandParams, SoilParams
 
 ArrayLike = float | np.ndarray
 _expm1 = np.expm1          # numpy's (not libm's): the array paths' bits
-_MIN_TRACK_SPEED_MPS = 0.05   # slip's held denominator (slip's default)
+MIN_TRACK_SPEED_MPS = 0.05    # slip's held denominator (slip's default)
 
 
 #: No dilatancy hardening: the plain (dry-sand) Wong force. The saturated sand's (van Os 1977;
@@ -51,7 +51,7 @@ def pore_suction_pa(slip_speed_mps: ArrayLike, pressure_pa: ArrayLike, saturatio
 
 
 def slip(track_speed_mps: ArrayLike, ground_speed_mps: ArrayLike,
-         min_track_speed_mps: float = 0.05) -> ArrayLike:
+         min_track_speed_mps: float = MIN_TRACK_SPEED_MPS) -> ArrayLike:
     """Signed slip i = (v_t - v_r) / v_t, held sane when the track is nearly stopped.
 
     Below ``min_track_speed_mps`` the denominator is held at that magnitude (with
@@ -183,7 +183,7 @@ def effective_weight_n(displacement_n: float, submerged_volume_m3: ArrayLike,
 # routine is not libm's).
 
 def slip_f(track_speed_mps: float, ground_speed_mps: float,
-           min_track_speed_mps: float = 0.05) -> float:
+           min_track_speed_mps: float = MIN_TRACK_SPEED_MPS) -> float:
     """``slip`` of two floats, without the scalar/array dispatch."""
     denom = max(abs(track_speed_mps), min_track_speed_mps) * (
         1.0 if track_speed_mps >= 0.0 else -1.0)
@@ -259,11 +259,11 @@ def track_force_f(patch: TrackPatch, track_speed_mps: float, ground_speed_mps: f
     same order."""
     v_t = track_speed_mps
     if v_t >= 0.0:                           # slip_f: max(|v|, 0.05) x sign, exact either way
-        i = (v_t - ground_speed_mps) / (v_t if v_t > _MIN_TRACK_SPEED_MPS
-                                        else _MIN_TRACK_SPEED_MPS)
+        i = (v_t - ground_speed_mps) / (v_t if v_t > MIN_TRACK_SPEED_MPS
+                                        else MIN_TRACK_SPEED_MPS)
     else:
-        i = (v_t - ground_speed_mps) / -(-v_t if -v_t > _MIN_TRACK_SPEED_MPS
-                                         else _MIN_TRACK_SPEED_MPS)
+        i = (v_t - ground_speed_mps) / -(-v_t if -v_t > MIN_TRACK_SPEED_MPS
+                                         else MIN_TRACK_SPEED_MPS)
     i = -1.0 if i < -1.0 else (1.0 if i > 1.0 else i)
     w = patch.weight_n
     if i == 0.0 or w <= 0.0:                 # sign(i) x 0 strength: signed zeros as numpy's
@@ -298,11 +298,11 @@ def track_force_slopes_f(patch: TrackPatch, track_speed_mps: float,
     v_t = track_speed_mps
     slip_mps = v_t - ground_speed_mps
     if v_t >= 0.0:                           # as track_force_f
-        held = not v_t > _MIN_TRACK_SPEED_MPS
-        denom = _MIN_TRACK_SPEED_MPS if held else v_t
+        held = not v_t > MIN_TRACK_SPEED_MPS
+        denom = MIN_TRACK_SPEED_MPS if held else v_t
     else:
-        held = not -v_t > _MIN_TRACK_SPEED_MPS
-        denom = -(_MIN_TRACK_SPEED_MPS if held else -v_t)
+        held = not -v_t > MIN_TRACK_SPEED_MPS
+        denom = -(MIN_TRACK_SPEED_MPS if held else -v_t)
     i = slip_mps / denom
     di_dg = -1.0 / denom
     di_dv = -di_dg if held else (1.0 - i) / denom       # d/dv of (v - g) / v: g / v^2
