@@ -193,6 +193,9 @@ class EkfSettings:
         'soil_scale.min_fraction', "a track-force update moves the soil's factor only where "
         'the tracks carry at least this share of the weight (less: the force is the product '
         'of a small weight and the factor, far from linear in either)', 0, 1)
+    soil_scale_from_held_tracks: bool = _f(
+        'soil_scale.from_held_tracks', "held belts slid over the sand by the waves move the "
+        "soil's factor too (false: their braking force corrects the surface only)")
     soil_scale_min: float = _f('soil_scale.min', "lower bound of the soil's strength factor",
                                0.01, 1)
     soil_scale_max: float = _f('soil_scale.max', "upper bound of the soil's strength factor",

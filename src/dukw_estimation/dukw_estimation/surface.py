@@ -158,7 +158,8 @@ class SurfaceObserver:
             return
         speeds = (s.port.speed_mps, s.stbd.speed_mps)
         ground = ground_speeds(ekf.x, self.vehicle.body.hull_separation_m)
-        if self._held_sliding(speeds, ground):
+        held = self._held_sliding(speeds, ground)
+        if held:
             speeds = (0.0, 0.0)          # held belts: the encoder's noise is no speed
         elif not self._slipping(speeds, ground):
             return
@@ -167,7 +168,8 @@ class SurfaceObserver:
             return
         self.force_update_t_s = s.t_s
         for k in range(2):
-            self._track_force_update(ekf, k, measured[k], speeds[k], ground[k])
+            self._track_force_update(ekf, k, measured[k], speeds[k], ground[k],
+                                     self._teaches_soil(held))
         self.bound_by_dry_sensors(ekf, s.t_s)
 
     def _force_update_due(self, t_s: float) -> bool:
@@ -185,6 +187,18 @@ class SurfaceObserver:
         return least > 0.0 and all(abs(speeds[k]) < st.slip_stopped_track_mps
                                    and abs(ground[k]) >= least for k in range(2))
 
+    def _teaches_soil(self, held: bool) -> bool:
+        """Whether this force update may move the soil's strength factor: with the tracks
+        carrying ``soil_scale.min_fraction`` of the weight, and not from held belts slid over
+        the sand by the waves unless ``soil_scale.from_held_tracks`` (the waves carry a
+        vehicle only while they float it nearly off: the weight then is a wave's fleeting
+        share the surface estimate lags, and at the slide's speed the saturated sand's
+        suction many times its dry strength; the braking force is their product, not a
+        lasting property of the sand)."""
+        st = self.settings
+        return self.contact.fraction >= st.soil_scale_min_fraction and (
+            st.soil_scale_from_held_tracks or not held)
+
     def _slipping(self, speeds: tuple[float, float], ground: tuple[float, float]) -> bool:
         """Both tracks turn fast enough and slip enough for the force to tell the weight."""
         st = self.settings
@@ -193,8 +207,9 @@ class SurfaceObserver:
                    and abs(slips[k]) >= st.force_update_min_slip for k in range(2))
 
     def _track_force_update(self, ekf: MotionEkf, k: int, measured_n: float, track_mps: float,
-                            ground_mps: float) -> None:
-        """One track's (0 port, 1 starboard) soil force as a measurement of s and eta."""
+                            ground_mps: float, learn_soil: bool) -> None:
+        """One track's (0 port, 1 starboard) soil force as a measurement of s and eta (and
+        of the soil's strength factor where ``learn_soil``)."""
         st = self.settings
         x, P = ekf.x, ekf.P
         sin_t = math.sin(self.contact.slope_rad)
@@ -225,7 +240,6 @@ class SurfaceObserver:
             h[Idx.SOIL] = predicted / x[Idx.SOIL]    # the force is the factor x the model's
         var = st.force_update_sigma_n ** 2 + per_mps * per_mps * max(ground_var, 0.0) \
             + soil_spread * max(measured_n * measured_n, predicted * predicted)
-        learn_soil = self.contact.fraction >= st.soil_scale_min_fraction
         ekf.update_scalar(measured_n, predicted, h, var, st.force_update_gate,
                           only=SURFACE_STATES if learn_soil else WATER_SURFACE_STATES)
         self.clip_soil_scale(ekf)

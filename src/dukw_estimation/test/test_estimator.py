@@ -408,6 +408,26 @@ def test_held_tracks_of_a_vehicle_carried_over_the_sand_tell_the_weight():
     assert runs['still'][0].surface.force_update_t_s == -math.inf
 
 
+def test_held_tracks_slid_by_the_waves_correct_the_surface_not_the_soils_factor():
+    """Grounded in the surf with the tracks off on a beach weaker than the configured soil,
+    carried over the sand at 0.2 m/s: the held belts' braking force corrects the surface
+    but leaves the soil's strength factor where it was (soil_scale.from_held_tracks false:
+    the waves carry a vehicle they nearly float, the force a fleeting weight share times
+    the sand's rate-strengthened strength); with it true the same updates move the factor."""
+    weak = dataclasses.replace(soil_params(PARAMS), friction_angle_rad=0.0974,
+                               shear_modulus_m=0.0, cohesion_pa=180.0)
+    factor, updated = {}, {}
+    for held_teach in (False, True):
+        est = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, soil_online_enabled=False,
+                   soil_scale_sigma=0.3, soil_scale_from_held_tracks=held_teach)
+        _surf_run(est, -0.06, 0.0, track_mps=0.0, ground_mps=-0.2, site_soil=weak)
+        factor[held_teach] = est.ekf.x[Idx.SOIL]
+        updated[held_teach] = est.surface.force_update_t_s
+    assert updated[False] > 4.0 and updated[True] > 4.0      # the held belts were used
+    assert factor[False] == 1.0
+    assert abs(factor[True] - 1.0) > 0.05
+
+
 def test_a_weaker_beach_is_learnt_as_the_soils_factor_not_read_as_water():
     """On a beach weaker than the configured soil (the paper's 64 % fit), met in the surf with
     no dry sand to learn it first, the tracks' force is short of the configured model's:
