@@ -151,18 +151,26 @@ class MotionFilter:
         noise = None
         target = None
         if imu is not None and self.fresh('imu', now) and math.isfinite(self.accel_base[0]):
-            # gravity along the body axes from the attitude, scaled by the measured vertical
-            # specific force (heave accelerations afloat): g_up = f_z / (cos roll cos pitch)
-            fx, fy, fz = self.accel_base
-            tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
-            g_up = fz / max(tilt, 0.5)
-            accel = (fx + g_up * math.sin(imu.pitch_rad) + x[Idx.R] * x[Idx.V],
-                     fy - g_up * math.sin(imu.roll_rad) * math.cos(imu.pitch_rad)
-                     - x[Idx.R] * x[Idx.U])
+            ax, ay = self.gravity_free_accel()
+            accel = (ax + x[Idx.R] * x[Idx.V], ay - x[Idx.R] * x[Idx.U])
         else:
             noise = st.q_accel_no_imu_mps2
             target = self._drive_target(now, fraction)
         self.ekf.predict(dt, accel, target, noise, self.vehicle.site.beach_slope_rad)
+
+    def gravity_free_accel(self) -> tuple[float, float]:
+        """The last IMU sample's surge and sway acceleration at base_link, m/s^2, gravity
+        removed with its attitude (NaN without a sample with accelerations): gravity along
+        the body axes from the attitude, scaled by the measured vertical specific force
+        (heave accelerations afloat): g_up = f_z / (cos roll cos pitch)."""
+        imu = self.imu
+        if imu is None:
+            return math.nan, math.nan
+        fx, fy, fz = self.accel_base
+        tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
+        g_up = fz / max(tilt, 0.5)
+        return (fx + g_up * math.sin(imu.pitch_rad),
+                fy - g_up * math.sin(imu.roll_rad) * math.cos(imu.pitch_rad))
 
     def _drive_target(self, now: float, fraction: float) -> tuple[float, float, float] | None:
         st = self.settings
