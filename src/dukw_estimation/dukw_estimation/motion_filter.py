@@ -4,8 +4,9 @@ It keeps the latest motion inputs (IMU, track and propeller status), the sensors
 times, the GPS datum, and predicts the EKF forward: with the IMU's accelerations, else
 with the drive model (tracks when their share of the weight drives the vehicle, else the
 propellers). It corrects heading, yaw rate and gyro bias from the IMU, the position and
-velocity from the DGPS (antenna lever arm) and, GPS velocity stale on land, the speed
-from the tracks. The surface states' corrections live in ``surface.SurfaceObserver``.
+velocity from the DGPS (antenna lever arm), GPS velocity stale on land, the speed
+from the tracks, and at rest the zero velocity (``zero_velocity``). The surface states'
+corrections live in ``surface.SurfaceObserver``.
 """
 from __future__ import annotations
 
@@ -52,6 +53,13 @@ _H_GYRO.flags.writeable = False
 _H_YAW = np.zeros(N_STATES)
 _H_YAW[_YAW] = 1.0
 _H_YAW.flags.writeable = False
+#: the zero-velocity update's rows (read only): surge u, sway v
+_H_U = np.zeros(N_STATES)
+_H_U[_U] = 1.0
+_H_U.flags.writeable = False
+_H_V = np.zeros(N_STATES)
+_H_V[_V] = 1.0
+_H_V.flags.writeable = False
 
 class MotionFilter:
     """Pose, twist, gyro bias and GPS bias of base_link in odom (and the EKF's time)."""
@@ -303,6 +311,15 @@ class MotionFilter:
         var = st.track_odometry_mps ** 2
         R = np.diag([var, var / st.effective_track_width_m ** 2])
         self.ekf.update(z, self.ekf.x[[Idx.U, Idx.R]], H, R, math.inf)
+
+    # ------------------------------------------------------------------ at rest
+    def zero_velocity(self, sigma_mps: float, gate: float) -> Outcome:
+        """The vehicle at rest: surge and sway measured as 0 with ``sigma_mps`` (two scalar
+        updates; the first not accepted is the outcome)."""
+        var = sigma_mps * sigma_mps
+        out = self.ekf.update_scalar(0.0, float(self.ekf.x[_U]), _H_U, var, gate)
+        out_v = self.ekf.update_scalar(0.0, float(self.ekf.x[_V]), _H_V, var, gate)
+        return out if out is not Outcome.ACCEPTED else out_v
 
     # ------------------------------------------------------------------ output
     def odometry(self, slope_rad: float) -> OdometryEstimate:

@@ -146,6 +146,28 @@ class EkfSettings:
         'slip.stopped_track_mps', 'a track reported slower than this counts as stopped for '
         'its slip (its sign is the encoder noise: a spinning-up belt read as reversing gave '
         'slip +1 against the truth -1)', 0, 1)
+    # zero-velocity update (ZUPT): belts stopped, the IMU still, on the sand -> ground speed 0
+    zupt_enabled: bool = _f('zupt.enabled', 'at rest (both belts stopped, the IMU still, not '
+                            'afloat) the ground velocity is measured as zero')
+    zupt_window_s: float = _f('zupt.window_s', "the stance detector's window (stance.py)",
+                              0.02, 10)
+    zupt_threshold: float = _f('zupt.threshold', "still while the IMU's moving variance, over "
+                               'its noise (1 ~ noise alone), stays below this', 1.01, 1e6)
+    zupt_accel_sigma_mps2: float = _f('zupt.accel_sigma_mps2', "the IMU's specific force noise "
+                                      'per axis where a sample carries no covariance '
+                                      '(the angular rates: noise.gyro_rps)', 1e-5, 10)
+    zupt_mean_accel_mps2: float = _f('zupt.mean_accel_mps2', "and while the window's mean "
+                                     'surge and sway acceleration (gravity removed with the '
+                                     "IMU's attitude) is under this (a steady push varies "
+                                     'nothing)', 1e-4, 10)
+    zupt_min_fraction: float = _f('zupt.min_fraction', 'and while the tracks carry at least '
+                                  'this share of the weight (less: the waves push the hull '
+                                  'over the sand steadily, which a still IMU does not show)',
+                                  0, 1)
+    zupt_sigma_mps: float = _f('zupt.sigma_mps', 'sigma of the zero surge and sway speed '
+                               '(what a still IMU and stopped belts leave unseen)', 1e-4, 1)
+    zupt_gate: float = _f('zupt.mahalanobis', 'rejection distance of the zero speed (a vehicle '
+                          'moving steadily, which the moving variance cannot see)', 0.5, 1e6)
     # the measured track forces as a measurement of the weight on the tracks
     force_update_min_slip: float = _f('force_update.min_slip', 'both tracks slipping at least '
                                       'this much: the Wong force then tells the weight', 0, 1)

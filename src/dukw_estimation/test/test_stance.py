@@ -1,0 +1,75 @@
+"""The stance detector (stance.py) on synthetic IMU streams."""
+import math
+
+import numpy as np
+import pytest
+
+from dukw_common.readings import ImuSample
+from dukw_estimation.stance import StanceDetector, StanceSettings
+
+G = 9.81
+SETTINGS = StanceSettings(window_s=0.5, threshold=2.0, accel_sigma_mps2=0.01,
+                          gyro_sigma_rps=0.003, mean_accel_mps2=0.1, mean_rate_rps=0.02)
+
+
+def _feed(detector, seconds, t0=0.0, seed=0, accel=lambda t: 0.0, roll_rate=lambda t: 0.0,
+          gyro_bias=0.0):
+    """An IMU at 100 Hz with its noise; returns (still, statistic) after each sample."""
+    rng = np.random.default_rng(seed)
+    n = rng.normal
+    out = []
+    for k in range(1, int(round(seconds / 0.01)) + 1):
+        t = t0 + k * 0.01
+        a = accel(t)
+        s = ImuSample(t, 0.0, 0.0, 0.0, roll_rate(t) + n(0, 0.003), n(0, 0.003),
+                      gyro_bias + n(0, 0.003), a + n(0, 0.01), n(0, 0.01), G + n(0, 0.01))
+        out.append((detector.add(s, (a + n(0, 0.01), n(0, 0.01))), detector.statistic))
+    return out
+
+
+def test_an_imu_measuring_only_its_noise_is_still_a_gyro_bias_does_not_matter():
+    detector = StanceDetector(SETTINGS)
+    out = _feed(detector, 3.0, gyro_bias=0.01)          # 3 sigma of bias on the yaw rate
+    assert not any(still for still, _ in out[:49])     # the first window is not full yet
+    statistics = [stat for _, stat in out[60:]]
+    assert np.mean(statistics) == pytest.approx(1.0, abs=0.1)
+    assert all(still for still, _ in out[60:])
+
+
+def test_rolling_in_the_waves_is_motion():
+    """The rate changes within the window, or near its peaks its mean is large."""
+    detector = StanceDetector(SETTINGS)
+    out = _feed(detector, 5.0, roll_rate=lambda t: 0.05 * math.sin(2 * math.pi * 0.3 * t))
+    assert not any(still for still, _ in out)
+    blind = StanceDetector(StanceSettings(0.5, 2.0, 0.01, 0.003, 0.1, mean_rate_rps=1.0))
+    out = _feed(blind, 5.0, roll_rate=lambda t: 0.05 * math.sin(2 * math.pi * 0.3 * t))
+    assert any(still for still, _ in out)            # the variance alone misses the peaks
+
+
+def test_a_steady_push_varies_nothing_but_its_mean_is_motion():
+    detector = StanceDetector(SETTINGS)
+    out = _feed(detector, 2.0, accel=lambda t: 0.24)
+    assert np.mean([stat for _, stat in out[60:]]) < SETTINGS.threshold
+    assert not any(still for still, _ in out)
+    assert detector.mean_accel_mps2 == pytest.approx(0.24, abs=0.01)
+
+
+def test_a_gap_or_a_sample_without_accelerations_starts_the_window_again():
+    detector = StanceDetector(SETTINGS)
+    _feed(detector, 1.0)
+    assert detector.still
+    out = _feed(detector, 1.0, t0=1.5)                  # 0.5 s silent: more than half a window
+    assert not out[0][0] and not out[40][0] and out[-1][0]
+    nan = ImuSample(2.6, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, math.nan, math.nan, math.nan)
+    assert not detector.add(nan, (math.nan, math.nan))
+    assert not _feed(detector, 0.3, t0=2.6)[-1][0]
+
+
+@pytest.mark.parametrize('bad', [{'threshold': 1.0}, {'window_s': 0.0},
+                                 {'accel_sigma_mps2': math.nan}, {'mean_accel_mps2': -1.0}])
+def test_bad_settings_are_refused(bad):
+    values = dict(window_s=0.5, threshold=2.0, accel_sigma_mps2=0.01, gyro_sigma_rps=0.003,
+                  mean_accel_mps2=0.1, mean_rate_rps=0.02)
+    values.update(bad)
+    with pytest.raises(ValueError, match=next(iter(bad))):
+        StanceSettings(**values)
