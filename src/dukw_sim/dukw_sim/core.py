@@ -69,6 +69,7 @@ class _Drives(NamedTuple):
     others: list                 # motor force besides the soil's: friction + paddling, N
     paddle: list                 # the tracks' paddle force on the vehicle, N
     loop_k: tuple                # speed-loop stiffness, N per m/s (inf: holds its speed)
+    loop_ref: tuple              # speed-loop reference, m/s
     contact: TrackContact | None
     lin: TrackLinear             # the soil forces linearised at the step's ground speeds
 
@@ -138,6 +139,14 @@ def _make_world(vehicle: Vehicle, params: SimParams, rng: np.random.Generator) -
     else:
         waves = no_waves()
     return World(beach, waves, w.breaking_ratio, w.reference_depth_m, w.second_order)
+
+
+def _loaded_speed(loop_ref_mps: float, force_n: float, loop_k: float) -> float:
+    """Track speed of a speed loop (not at its current limit) giving this force to the soil
+    and the drivetrain's friction, m/s."""
+    if math.isinf(loop_k):
+        return loop_ref_mps
+    return loop_ref_mps - force_n / loop_k      # afloat too: friction, paddling
 
 
 class SimCore:
@@ -469,9 +478,10 @@ class SimCore:
         # the speed loops give under load; at a zero command they hold the track (brake)
         loop_k = (self._loop_k if targets[0] != 0.0 else math.inf,
                   self._loop_k if targets[1] != 0.0 else math.inf)
-        lin = linearise(contact, tuple(ref), ground, tuple(others), loop_k,
+        loop_ref = tuple(ref)
+        lin = linearise(contact, loop_ref, ground, tuple(others), loop_k,
                         tuple(self.track_speed))
-        return _new_tuple(_Drives, (ground, others, paddle, loop_k, contact, lin))
+        return _new_tuple(_Drives, (ground, others, paddle, loop_k, loop_ref, contact, lin))
 
     def _track_contact(self, w_eff: float) -> TrackContact | None:
         """The tracks' patches on the sand: dry or wet soil by position; under the surf the
@@ -579,10 +589,12 @@ class SimCore:
         others, contact, loop_k = drives.others, drives.contact, drives.loop_k
         self.u, self.v, self.r = u0 + du, v0 + dv, r0 + dr
         ground_new = (self.u - self.r * half, self.u + self.r * half)
+        loop_ref = drives.loop_ref
         speeds = [motor_limited_speed(contact, self.ref[0], ground_new[0], new[0])
-                  if limited[0] else self._loaded_speed(0, new[0] + others[0], loop_k[0]),
+                  if limited[0] else _loaded_speed(loop_ref[0], new[0] + others[0], loop_k[0]),
                   motor_limited_speed(contact, self.ref[1], ground_new[1], new[1])
-                  if limited[1] else self._loaded_speed(1, new[1] + others[1], loop_k[1])]
+                  if limited[1] else _loaded_speed(loop_ref[1], new[1] + others[1], loop_k[1])]
+        motor = [new[0] + others[0], new[1] + others[1]]
         self.track_speed = speeds
         slips = [traction.slip_f(speeds[0], ground_new[0]),
                  traction.slip_f(speeds[1], ground_new[1])]
@@ -590,8 +602,7 @@ class SimCore:
         self.yaw = (self.yaw + dt * self.r + math.pi) % (2.0 * math.pi) - math.pi
         self.x += dt * (c * self.u - s * self.v)
         self.y += dt * (s * self.u + c * self.v)
-        return _new_tuple(TrackState, (speeds, new, [new[0] + others[0], new[1] + others[1]],
-                                       slips))
+        return _new_tuple(TrackState, (speeds, new, motor, slips))
 
     def _solve_surge_yaw(self, base: tuple, drives: _Drives):
         """Surge and yaw-rate change, implicit in the soil forces: Newton passes, each
@@ -613,7 +624,7 @@ class SimCore:
                 break
             guess = predicted_speeds(lin, drives.loop_k, g_lin, g_next)
             g_lin = g_next
-            lin = linearise(contact, tuple(self.ref), g_lin, tuple(others), drives.loop_k,
+            lin = linearise(contact, drives.loop_ref, g_lin, tuple(others), drives.loop_k,
                             guess)
         if contact is not None:
             slip_p, slip_s = lin.speed_mps[0] - ground[0], lin.speed_mps[1] - ground[1]
@@ -625,9 +636,7 @@ class SimCore:
         # the soil force is nearly a step at these slips (firm sand, low speed): the tracks
         # grip; solve the step with the ground under the tracks moving at the tracks'
         # (loaded) speeds, within what the soil and the motors can give
-        if any(math.isinf(k) for k in drives.loop_k):
-            return self._grip_step(base, contact, u0, r0, others)
-        return self._loaded_grip_step(base, contact, u0, r0, others, drives.loop_k)
+        return self._grip_step(base, drives)
 
     def _follow_ground(self) -> None:
         """On the ground: take the beach's pose; the rates are the pose's change over the step."""
@@ -696,58 +705,42 @@ class SimCore:
                 break
         return du, dr, new, limited
 
-    def _grip_step(self, base: tuple, contact, u0: float, r0: float, others: list):
-        """Surge and yaw-rate change with the tracks gripping (no slip), forces capped by
-        the soil's strength and the motors' limit. Returns (du, dr, forces, limited)."""
+    def _grip_step(self, base: tuple, drives: _Drives):
+        """Surge and yaw-rate change with the tracks gripping (no slip): the ground under
+        each track moves at the track's loaded speed g_i = ref_i - c_i (F_i + o_i), c_i =
+        1/k_i the loop's compliance (0: a held track runs at its reference), each force
+        capped by the soil's strength and the motors' limit (a capped track slides, the
+        other still grips). Returns (du, dr, forces, limited)."""
         x0, n0, m_x, i_z, j_u, j_r = base
         dt, half = self.dt_s, self._half_sep
-        du = 0.5 * (self.ref[0] + self.ref[1]) - u0
-        dr = (self.ref[1] - self.ref[0]) / (2.0 * half) - r0
-        total = m_x * du / dt - x0 - j_u * du
-        turn = (i_z * dr / dt - n0 - j_r * dr) / half
-        want = [0.5 * (total - turn), 0.5 * (total + turn)]
-        strength = contact.strength_n()
-        limited = [False, False]
-        force = []
-        for i in range(2):
-            lo = max(-strength, -self._max_motor_n - others[i])
-            hi = min(strength, self._max_motor_n - others[i])
-            limited[i] = not lo <= want[i] <= hi
-            force.append(min(max(want[i], lo), hi))
-        if any(limited):
-            du = dt * (x0 + force[0] + force[1]) / (m_x - dt * j_u)
-            dr = dt * (n0 + (force[1] - force[0]) * half) / (i_z - dt * j_r)
+        others, loop_ref = drives.others, drives.loop_ref
+        comp = [0.0 if math.isinf(k) else 1.0 / k for k in drives.loop_k]
+        # du = a (x0 + F0 + F1), half dr = b (n0 / half + F1 - F0): the ground speeds' change
+        # per N is a + b of the track's own force, a - b of the other's
+        a = dt / (m_x - dt * j_u)
+        b = dt * half * half / (i_z - dt * j_r)
+        turn = b * n0 / half
+        rhs = [loop_ref[0] - comp[0] * others[0] - drives.ground[0] - a * x0 + turn,
+               loop_ref[1] - comp[1] * others[1] - drives.ground[1] - a * x0 - turn]
+        own, cross = [a + b + comp[0], a + b + comp[1]], a - b
+        det = own[0] * own[1] - cross * cross
+        force = [(rhs[0] * own[1] - cross * rhs[1]) / det,
+                 (own[0] * rhs[1] - cross * rhs[0]) / det]
+        strength = drives.contact.strength_n()
+        bounds = [(max(-strength, -self._max_motor_n - o), min(strength, self._max_motor_n - o))
+                  for o in others]
+        limited = [not lo <= f <= hi for f, (lo, hi) in zip(force, bounds, strict=True)]
+        if limited[0] != limited[1]:
+            # one track slides at its bound; the other grips with that force fixed
+            j = 0 if limited[0] else 1
+            i = 1 - j
+            force[j] = min(max(force[j], bounds[j][0]), bounds[j][1])
+            force[i] = (rhs[i] - cross * force[j]) / own[i]
+            limited[i] = not bounds[i][0] <= force[i] <= bounds[i][1]
+        force = [min(max(f, lo), hi) for f, (lo, hi) in zip(force, bounds, strict=True)]
+        du = a * (x0 + force[0] + force[1])
+        dr = b * (n0 / half + force[1] - force[0]) / half
         return du, dr, force, limited
-
-    def _loaded_grip_step(self, base: tuple, contact, u0: float, r0: float, others: list,
-                          loop_k: tuple):
-        """As _grip_step, with the tracks' speeds those of loaded speed loops:
-        F_i + o_i = k_i (ref_i - g_i), g the new ground speeds (linear, decoupled)."""
-        x0, n0, m_x, i_z, j_u, j_r = base
-        dt, half = self.dt_s, self._half_sep
-        a = [loop_k[0] * (self.ref[0] - u0 + r0 * half) - others[0],
-             loop_k[1] * (self.ref[1] - u0 - r0 * half) - others[1]]
-        k_sum = loop_k[0] + loop_k[1]
-        du = dt * (x0 + a[0] + a[1]) / (m_x - dt * j_u + dt * k_sum)
-        dr = dt * (n0 + (a[1] - a[0]) * half) / (i_z - dt * j_r + dt * k_sum * half * half)
-        force = [a[0] - loop_k[0] * (du - dr * half), a[1] - loop_k[1] * (du + dr * half)]
-        strength = contact.strength_n()
-        limited = [False, False]
-        for i in range(2):
-            lo = max(-strength, -self._max_motor_n - others[i])
-            hi = min(strength, self._max_motor_n - others[i])
-            limited[i] = not lo <= force[i] <= hi
-            force[i] = min(max(force[i], lo), hi)
-        if any(limited):
-            du = dt * (x0 + force[0] + force[1]) / (m_x - dt * j_u)
-            dr = dt * (n0 + (force[1] - force[0]) * half) / (i_z - dt * j_r)
-        return du, dr, force, limited
-
-    def _loaded_speed(self, i: int, motor_force_n: float, loop_k: float) -> float:
-        """Track speed of a speed loop (not at its current limit) giving this force, m/s."""
-        if math.isinf(loop_k):
-            return self.ref[i]
-        return self.ref[i] - motor_force_n / loop_k      # afloat too: friction, paddling
 
     def _prop_thrust_factors(self, eta: np.ndarray) -> list[float]:
         """Port and starboard thrust shares from each propeller's depth under the surface."""

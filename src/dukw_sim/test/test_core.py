@@ -230,6 +230,29 @@ def test_track_forces_are_smooth_from_rest():
     assert (rise > 0.0).all() and np.max(np.abs(np.diff(rise))) < 3.0
 
 
+def test_a_loaded_track_beside_a_held_one_grips_where_its_loop_gives():
+    """Issue 18 (campaign runs 20, 31): one track held at a zero command, the other's loop
+    starting, the vehicle pushed back (a wave, here a tow line) on gripping sand. The loaded
+    track's belt runs at the ground's speed under it, and gives under its load with the
+    belt's inertia; before, the grip step held both tracks at their references and the
+    loaded belt read ref - F / k (-0.21 m/s, slip 1) while the vehicle stood still."""
+    sim = SimCore.from_config()
+    sim.reset(x_m=-30.0)
+    run(sim, Actuation(0, 0), 20)
+    sim.set_external_force(-300.0)
+    half = sim.vehicle.body.hull_separation_m / 2.0
+    belt = [sim.truth.stbd_track_speed_mps]
+    for _ in range(40):
+        truth = sim.step(Actuation(0, 2))
+        ground_mps = truth.surge_mps + truth.yaw_rate_rps * half
+        assert truth.stbd_track_speed_mps == pytest.approx(ground_mps, abs=2e-4)
+        assert abs(truth.stbd_slip) < 5e-3 and truth.port_track_speed_mps == 0.0
+        belt.append(truth.stbd_track_speed_mps)
+    assert np.max(np.abs(np.diff(belt))) < 0.006          # no one-step jump
+    assert truth.stbd_force_n + truth.port_force_n == pytest.approx(300.0, rel=0.1)
+    assert truth.port_force_n > 3.0 * truth.stbd_force_n   # the held track takes the load
+
+
 @pytest.mark.parametrize('start', ['sand', 'surf', 'afloat'])
 def test_random_commands_keep_every_field_finite(start):
     rng = np.random.default_rng(11)
