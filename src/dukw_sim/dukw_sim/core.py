@@ -37,8 +37,8 @@ from dukw_sim.forces import (LATERAL_POINTS, BodyForces, Immersion, StripSums, W
                              sum_wrenches, surf_resistance, track_paddle_n, track_wetness,
                              water_yaw_rate_rps, wave_forcing, wave_moments)
 from dukw_sim.hull import HullGeometry, Seakeeping
-from dukw_sim.land import (TrackContact, TrackLinear, linearise, motor_limited_speed,
-                           predicted_speeds)
+from dukw_sim.land import (TrackContact, TrackLinear, belt_equivalent_mass_kg, belt_mass_kg,
+                           inertial_loop, linearise, motor_limited_speed, predicted_speeds)
 from dukw_sim.params import SimParams, apply_overrides
 from dukw_sim.truth import Medium, Truth
 from dukw_sim.world import (Beach, WaterSample, WaveModel, World, irregular_waves, no_waves,
@@ -68,8 +68,9 @@ class _Drives(NamedTuple):
     ground: tuple                # speed of the ground under each track, m/s (body surge)
     others: list                 # motor force besides the soil's: friction + paddling, N
     paddle: list                 # the tracks' paddle force on the vehicle, N
-    loop_k: tuple                # speed-loop stiffness, N per m/s (inf: holds its speed)
-    loop_ref: tuple              # speed-loop reference, m/s
+    loop_k: tuple                # speed loop with the belt's inertia over the step: its
+                                 # stiffness, N per m/s (inf: holds its speed) ...
+    loop_ref: tuple              # ... and its reference, m/s (land.inertial_loop)
     contact: TrackContact | None
     lin: TrackLinear             # the soil forces linearised at the step's ground speeds
 
@@ -143,7 +144,7 @@ def _make_world(vehicle: Vehicle, params: SimParams, rng: np.random.Generator) -
 
 def _loaded_speed(loop_ref_mps: float, force_n: float, loop_k: float) -> float:
     """Track speed of a speed loop (not at its current limit) giving this force to the soil
-    and the drivetrain's friction, m/s."""
+    and the drivetrain's friction, m/s (with the belt's inertia: land.inertial_loop)."""
     if math.isinf(loop_k):
         return loop_ref_mps
     return loop_ref_mps - force_n / loop_k      # afloat too: friction, paddling
@@ -177,6 +178,13 @@ class SimCore:
                                 * drive.full_scale_track_speed_mps)
         droop = land.speed_loop_droop_mps_per_kn / 1000.0       # m/s per N
         self._loop_k = 1.0 / droop if droop > 0.0 else math.inf   # N per m/s
+        # each drive's inertia at the belt, and that inertia over one implicit step, N per m/s
+        self._belt_mass_kg = belt_equivalent_mass_kg(
+            land.motor_rotor_inertia_kg_m2, drive.gear_reduction, drive.sprocket_diameter_m,
+            belt_mass_kg(land.belt_mass_per_area_kgpm2, body.track_width_m,
+                         body.track_contact_length_m, drive.sprocket_diameter_m),
+            land.track_wheels_inertia_kg_m2)
+        self._belt_n_per_mps = self._belt_mass_kg / self.dt_s
         self._wet_soil = _soil_with_floor(vehicle.soil, land.min_shear_modulus_m)
         dry = params.dry_soil or vehicle.soil
         self._dry_soil = _soil_with_floor(dry, land.min_shear_modulus_m)
@@ -475,12 +483,15 @@ class SimCore:
                   drivetrain_friction_n(drive.friction_n, speeds[1], ref[1], breakaway)
                   + paddle[1]]
         contact = self._track_contact(w_eff)
-        # the speed loops give under load; at a zero command they hold the track (brake)
-        loop_k = (self._loop_k if targets[0] != 0.0 else math.inf,
-                  self._loop_k if targets[1] != 0.0 else math.inf)
-        loop_ref = tuple(ref)
-        lin = linearise(contact, loop_ref, ground, tuple(others), loop_k,
-                        tuple(self.track_speed))
+        # the speed loops give under load; at a zero command they hold the track (brake);
+        # with the belts' inertia over the step (land.inertial_loop)
+        belt, inertia = self.track_speed, self._belt_n_per_mps
+        port_k, port_ref = inertial_loop(self._loop_k if targets[0] != 0.0 else math.inf,
+                                         ref[0], belt[0], inertia)
+        stbd_k, stbd_ref = inertial_loop(self._loop_k if targets[1] != 0.0 else math.inf,
+                                         ref[1], belt[1], inertia)
+        loop_k, loop_ref = (port_k, stbd_k), (port_ref, stbd_ref)
+        lin = linearise(contact, loop_ref, ground, tuple(others), loop_k, tuple(belt))
         return _new_tuple(_Drives, (ground, others, paddle, loop_k, loop_ref, contact, lin))
 
     def _track_contact(self, w_eff: float) -> TrackContact | None:
@@ -594,7 +605,8 @@ class SimCore:
                   if limited[0] else _loaded_speed(loop_ref[0], new[0] + others[0], loop_k[0]),
                   motor_limited_speed(contact, self.ref[1], ground_new[1], new[1])
                   if limited[1] else _loaded_speed(loop_ref[1], new[1] + others[1], loop_k[1])]
-        motor = [new[0] + others[0], new[1] + others[1]]
+        motor = [new[0] + others[0] + self._belt_force_n(0, speeds[0], limited[0], loop_k[0]),
+                 new[1] + others[1] + self._belt_force_n(1, speeds[1], limited[1], loop_k[1])]
         self.track_speed = speeds
         slips = [traction.slip_f(speeds[0], ground_new[0]),
                  traction.slip_f(speeds[1], ground_new[1])]
@@ -603,6 +615,15 @@ class SimCore:
         self.x += dt * (c * self.u - s * self.v)
         self.y += dt * (s * self.u + c * self.v)
         return _new_tuple(TrackState, (speeds, new, motor, slips))
+
+    def _belt_force_n(self, i: int, speed_mps: float, limited: bool, loop_k: float) -> float:
+        """The force a track's motor spends accelerating its belt (rotor, belt, wheels) over
+        the step, m_eq (v - v0) / dt, N: a speed loop's (land.inertial_loop); none for a
+        motor at its limit (the belt's speed there is the soil's, at the motor's force) or a
+        held track (it keeps the reference's speed: the ramp's <= 2 m/s^2, left out)."""
+        if limited or math.isinf(loop_k):
+            return 0.0
+        return self._belt_n_per_mps * (speed_mps - self.track_speed[i])
 
     def _solve_surge_yaw(self, base: tuple, drives: _Drives):
         """Surge and yaw-rate change, implicit in the soil forces: Newton passes, each

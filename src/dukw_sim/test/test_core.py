@@ -71,6 +71,26 @@ def test_overrides_aliases_and_unknown_names():
         SimCore.from_config(overrides={'physics.dt_s': float('nan')})
 
 
+INERTIA = ('land.motor_rotor_inertia_kg_m2', 'land.belt_mass_per_area_kgpm2',
+           'land.track_wheels_inertia_kg_m2')
+
+
+def test_the_belts_inertia_comes_from_the_rotor_the_belt_and_its_wheels():
+    """m_eq = J_rotor (N / r)^2 + m_belt + J_wheels / r^2 from the config; all three 0: the
+    algebraic loop of before; a negative one is refused."""
+    base = SimCore.from_config()
+    drive, land = base.vehicle.drivetrain, base.params.land
+    assert SimCore.from_config(overrides={k: 0.0 for k in INERTIA})._belt_mass_kg == 0.0
+    more = SimCore.from_config(overrides={INERTIA[0]: 2.0 * land.motor_rotor_inertia_kg_m2})
+    reflected = (drive.gear_reduction / (drive.sprocket_diameter_m / 2.0)) ** 2
+    assert more._belt_mass_kg - base._belt_mass_kg == pytest.approx(
+        land.motor_rotor_inertia_kg_m2 * reflected)
+    assert base._belt_mass_kg > land.motor_rotor_inertia_kg_m2 * reflected
+    for name in INERTIA:
+        with pytest.raises(ConfigError):
+            SimCore.from_config(overrides={name: -1e-3})
+
+
 def test_reset_starts_on_sand_in_the_surf_and_afloat():
     sim = SimCore.from_config()
     sand = sim.reset('sand')
