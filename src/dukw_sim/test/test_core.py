@@ -273,6 +273,26 @@ def test_a_loaded_track_beside_a_held_one_grips_where_its_loop_gives():
     assert truth.port_force_n > 3.0 * truth.stbd_force_n   # the held track takes the load
 
 
+@pytest.mark.parametrize('zero_inertia', [False, True])
+def test_the_motor_limit_holds_with_the_belts_inertia(zero_inertia):
+    """Climbing 11 deg from rest at 100/96 the drives reach the controller's current limit:
+    the current never exceeds it (the belt's acceleration counted against the limit; with
+    it left out the start read 63.3 A), and at the limit the motor drives its belt against
+    the soil without a jump of the belt's speed."""
+    overrides = {'world.beach_slope_rad': math.radians(11.0)}
+    if zero_inertia:
+        overrides.update({k: 0.0 for k in INERTIA})
+    sim = SimCore.from_config(overrides=overrides)
+    sim.reset(x_m=-4.0, yaw_rad=math.pi)
+    limit_a = sim.params.land.max_current_a
+    truths = [sim.step(Actuation(100, 96)) for _ in range(300)]
+    current = np.array([[t.port_current_a, t.stbd_current_a] for t in truths])
+    assert current.max() <= limit_a + 1e-9
+    assert current.max() > limit_a - 0.1            # it does reach the limit
+    belt = np.array([[t.port_track_speed_mps, t.stbd_track_speed_mps] for t in truths])
+    assert np.abs(np.diff(belt, axis=0)).max() < 0.045
+
+
 @pytest.mark.parametrize('start', ['sand', 'surf', 'afloat'])
 def test_random_commands_keep_every_field_finite(start):
     rng = np.random.default_rng(11)
