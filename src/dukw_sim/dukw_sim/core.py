@@ -37,8 +37,8 @@ from dukw_sim.forces import (LATERAL_POINTS, BodyForces, Immersion, StripSums, W
                              sum_wrenches, surf_resistance, track_paddle_n, track_wetness,
                              water_yaw_rate_rps, wave_forcing, wave_moments)
 from dukw_sim.hull import HullGeometry, Seakeeping
-from dukw_sim.land import (TrackContact, TrackLinear, linearise, motor_limited_speed,
-                           predicted_speeds)
+from dukw_sim.land import (TrackContact, TrackLinear, belt_equivalent_mass_kg, belt_mass_kg,
+                           inertial_loop, linearise, motor_limited_speed, predicted_speeds)
 from dukw_sim.params import SimParams, apply_overrides
 from dukw_sim.truth import Medium, Truth
 from dukw_sim.world import (Beach, WaterSample, WaveModel, World, irregular_waves, no_waves,
@@ -51,6 +51,7 @@ _LAND_FRACTION = 0.02          # submerged share of the afloat volume below whic
 _NEWTON_PASSES = 3             # implicit track-soil solve
 _NEWTON_TOL_MPS = 2e-4
 _CLEAR_MARGIN_M = 1e-9          # touchdown's shortcut: clear of the sand by more than this
+_SLIDING = 2                    # a limited track at the soil's strength (the motor's: +-1)
 
 
 class TrackState(NamedTuple):
@@ -68,7 +69,11 @@ class _Drives(NamedTuple):
     ground: tuple                # speed of the ground under each track, m/s (body surge)
     others: list                 # motor force besides the soil's: friction + paddling, N
     paddle: list                 # the tracks' paddle force on the vehicle, N
-    loop_k: tuple                # speed-loop stiffness, N per m/s (inf: holds its speed)
+    loop_k: tuple                # speed loop with the belt's inertia over the step: its
+                                 # stiffness, N per m/s (inf: holds its speed) ...
+    loop_ref: tuple              # ... and its reference, m/s (land.inertial_loop)
+    motor_map: tuple             # the motor's force for a load L on the loop: g L + b, per
+                                 # track (g_p, b_p, g_s, b_s): the belt's acceleration added
     contact: TrackContact | None
     lin: TrackLinear             # the soil forces linearised at the step's ground speeds
 
@@ -140,6 +145,28 @@ def _make_world(vehicle: Vehicle, params: SimParams, rng: np.random.Generator) -
     return World(beach, waves, w.breaking_ratio, w.reference_depth_m, w.second_order)
 
 
+def _loaded_speed(loop_ref_mps: float, force_n: float, loop_k: float) -> float:
+    """Track speed of a speed loop (not at its current limit) giving this force to the soil
+    and the drivetrain's friction, m/s (with the belt's inertia: land.inertial_loop)."""
+    if math.isinf(loop_k):
+        return loop_ref_mps
+    return loop_ref_mps - force_n / loop_k      # afloat too: friction, paddling
+
+
+def _grip_forces(a: float, b: float, rhs: list, comp: list, fixed: list) -> list[float]:
+    """The two tracks' soil forces of the grip step: (a + b + c_i) F_i + (a - b) F_j =
+    rhs_i for each track whose force is not ``fixed`` (None), N."""
+    own, cross = [a + b + comp[0], a + b + comp[1]], a - b
+    if fixed[0] is not None and fixed[1] is not None:
+        return list(fixed)
+    if fixed[0] is not None:
+        return [fixed[0], (rhs[1] - cross * fixed[0]) / own[1]]
+    if fixed[1] is not None:
+        return [(rhs[0] - cross * fixed[1]) / own[0], fixed[1]]
+    det = own[0] * own[1] - cross * cross
+    return [(rhs[0] * own[1] - cross * rhs[1]) / det, (own[0] * rhs[1] - cross * rhs[0]) / det]
+
+
 class SimCore:
     """The vehicle in its world, advanced one fixed step at a time."""
 
@@ -168,6 +195,13 @@ class SimCore:
                                 * drive.full_scale_track_speed_mps)
         droop = land.speed_loop_droop_mps_per_kn / 1000.0       # m/s per N
         self._loop_k = 1.0 / droop if droop > 0.0 else math.inf   # N per m/s
+        # each drive's inertia at the belt, and that inertia over one implicit step, N per m/s
+        self._belt_mass_kg = belt_equivalent_mass_kg(
+            land.motor_rotor_inertia_kg_m2, drive.gear_reduction, drive.sprocket_diameter_m,
+            belt_mass_kg(land.belt_mass_per_area_kgpm2, body.track_width_m,
+                         body.track_contact_length_m, drive.sprocket_diameter_m),
+            land.track_wheels_inertia_kg_m2)
+        self._belt_n_per_mps = self._belt_mass_kg / self.dt_s
         self._wet_soil = _soil_with_floor(vehicle.soil, land.min_shear_modulus_m)
         dry = params.dry_soil or vehicle.soil
         self._dry_soil = _soil_with_floor(dry, land.min_shear_modulus_m)
@@ -466,12 +500,23 @@ class SimCore:
                   drivetrain_friction_n(drive.friction_n, speeds[1], ref[1], breakaway)
                   + paddle[1]]
         contact = self._track_contact(w_eff)
-        # the speed loops give under load; at a zero command they hold the track (brake)
-        loop_k = (self._loop_k if targets[0] != 0.0 else math.inf,
-                  self._loop_k if targets[1] != 0.0 else math.inf)
-        lin = linearise(contact, tuple(ref), ground, tuple(others), loop_k,
-                        tuple(self.track_speed))
-        return _new_tuple(_Drives, (ground, others, paddle, loop_k, contact, lin))
+        # the speed loops give under load; at a zero command they hold the track (brake);
+        # with the belts' inertia over the step (land.inertial_loop)
+        belt, inertia = self.track_speed, self._belt_n_per_mps
+        port_k, port_ref = inertial_loop(self._loop_k if targets[0] != 0.0 else math.inf,
+                                         ref[0], belt[0], inertia)
+        stbd_k, stbd_ref = inertial_loop(self._loop_k if targets[1] != 0.0 else math.inf,
+                                         ref[1], belt[1], inertia)
+        loop_k, loop_ref = (port_k, stbd_k), (port_ref, stbd_ref)
+        lin = linearise(contact, loop_ref, ground, tuple(others), loop_k, tuple(belt))
+        # motor = L + m/dt (v - v0), v = ref' - L / k': (1 - m/dt / k') L + m/dt (ref' - v0);
+        # a held track: L (its belt follows the ramped reference, left out)
+        motor_map = (1.0 - inertia / port_k,
+                     inertia * (port_ref - belt[0]) if port_k != math.inf else 0.0,
+                     1.0 - inertia / stbd_k,
+                     inertia * (stbd_ref - belt[1]) if stbd_k != math.inf else 0.0)
+        return _new_tuple(_Drives, (ground, others, paddle, loop_k, loop_ref, motor_map,
+                                    contact, lin))
 
     def _track_contact(self, w_eff: float) -> TrackContact | None:
         """The tracks' patches on the sand: dry or wet soil by position; under the surf the
@@ -576,13 +621,9 @@ class SimCore:
         dv = dt * (forces.y_n - m_x * u0 * r0) / (m_y - dt * forces.dy_dv)
         base = (forces.x_n + m_y * v0 * r0, forces.n_nm, m_x, i_z, forces.dx_du, forces.dn_dr)
         du, dr, new, limited = self._solve_surge_yaw(base, drives)
-        others, contact, loop_k = drives.others, drives.contact, drives.loop_k
         self.u, self.v, self.r = u0 + du, v0 + dv, r0 + dr
         ground_new = (self.u - self.r * half, self.u + self.r * half)
-        speeds = [motor_limited_speed(contact, self.ref[0], ground_new[0], new[0])
-                  if limited[0] else self._loaded_speed(0, new[0] + others[0], loop_k[0]),
-                  motor_limited_speed(contact, self.ref[1], ground_new[1], new[1])
-                  if limited[1] else self._loaded_speed(1, new[1] + others[1], loop_k[1])]
+        speeds, motor = self._belts(limited, new, ground_new, drives)
         self.track_speed = speeds
         slips = [traction.slip_f(speeds[0], ground_new[0]),
                  traction.slip_f(speeds[1], ground_new[1])]
@@ -590,8 +631,78 @@ class SimCore:
         self.yaw = (self.yaw + dt * self.r + math.pi) % (2.0 * math.pi) - math.pi
         self.x += dt * (c * self.u - s * self.v)
         self.y += dt * (s * self.u + c * self.v)
-        return _new_tuple(TrackState, (speeds, new, [new[0] + others[0], new[1] + others[1]],
-                                       slips))
+        return _new_tuple(TrackState, (speeds, new, motor, slips))
+
+    def _belt_inertial(self, contact) -> bool:
+        """Whether a motor at its limit drives a belt with inertia against the soil."""
+        return self._belt_n_per_mps > 0.0 and contact is not None
+
+    def _belts(self, limited: list, force_n: list, ground_mps: tuple,
+               drives: _Drives) -> tuple[list, list]:
+        """Both tracks' belt speeds (m/s) and motor forces (N) after the step."""
+        if limited[0] or limited[1]:
+            speeds = [self._belt_speed(i, limited[i], force_n[i], ground_mps[i], drives)
+                      for i in (0, 1)]
+            return speeds, [self._motor_force_n(i, limited[i], force_n[i], drives)
+                            for i in (0, 1)]
+        others, loop_k, loop_ref, motor_map = (drives.others, drives.loop_k, drives.loop_ref,
+                                               drives.motor_map)
+        load = (force_n[0] + others[0], force_n[1] + others[1])
+        return ([_loaded_speed(loop_ref[0], load[0], loop_k[0]),
+                 _loaded_speed(loop_ref[1], load[1], loop_k[1])],
+                [motor_map[0] * load[0] + motor_map[1], motor_map[2] * load[1] + motor_map[3]])
+
+    def _belt_speed(self, i: int, limited: int, force_n: float, ground_mps: float,
+                    drives: _Drives) -> float:
+        """A track's belt speed after the step, m/s: its loop's loaded speed; at the motor's
+        limit the belt the motor's force accelerates against the soil's, m_eq (v - v0) / dt =
+        +-max - o - F (without inertia, or sliding at the soil's strength: the speed at
+        which the soil takes that force)."""
+        if limited == _SLIDING or (limited and not self._belt_inertial(drives.contact)):
+            return motor_limited_speed(drives.contact, self.ref[i], ground_mps, force_n)
+        if limited:
+            return self.track_speed[i] + (limited * self._max_motor_n - drives.others[i]
+                                          - force_n) / self._belt_n_per_mps
+        return _loaded_speed(drives.loop_ref[i], force_n + drives.others[i], drives.loop_k[i])
+
+    def _motor_force_n(self, i: int, limited: int, force_n: float, drives: _Drives) -> float:
+        """A track motor's force, N: the soil's, the drivetrain's friction and paddling and
+        what accelerates the belt (rotor, belt, wheels), m_eq (v - v0) / dt. A held track
+        (it keeps the reference's speed: the ramp's <= 2 m/s^2 left out) and a sliding one
+        without it; a motor at its limit with inertia gives exactly its limit."""
+        if limited in (1, -1) and self._belt_inertial(drives.contact):
+            return limited * self._max_motor_n
+        load_n = force_n + drives.others[i]
+        if limited:
+            return load_n
+        return self._loop_motor_n(i, load_n, drives)
+
+    @staticmethod
+    def _loop_motor_n(i: int, load_n: float, drives: _Drives) -> float:
+        """The motor force of a track's loop giving ``load_n`` to the soil and the drivetrain
+        (its belt at the loaded speed, accelerated from the last one), N."""
+        gain, offset = drives.motor_map[2 * i:2 * i + 2]
+        return gain * load_n + offset
+
+    def _limited_ref(self, i: int, motor_n: float, others_n: float) -> float:
+        """A belt driven at the motor's limit as a loop of stiffness m_eq / dt (no other
+        force): its reference v0 + (motor - o) dt / m_eq, m/s."""
+        return self.track_speed[i] + (motor_n - others_n) / self._belt_n_per_mps
+
+    def _at_motor_limit(self, i: int, motor_n: float, drives: _Drives, g_lin: tuple,
+                        g_old: tuple) -> tuple[float, float]:
+        """A track whose motor gives its limit ``motor_n``: its soil force linearised in the
+        ground speed, (force at g_old, d force / d ground). The belt the motor accelerates
+        against the soil is a loop of stiffness m_eq / dt (land.inertial_loop); without
+        inertia the soil takes the motor's force less the friction (derivative 0)."""
+        if not self._belt_inertial(drives.contact):
+            return motor_n - drives.others[i], 0.0
+        ref = self._limited_ref(i, motor_n, drives.others[i])
+        k = self._belt_n_per_mps
+        lin = linearise(drives.contact, (ref, ref), (g_lin[i], g_lin[i]), (0.0, 0.0), (k, k),
+                        (self.track_speed[i], self.track_speed[i]))
+        slope = lin.dforce_dground[0]
+        return lin.force_n[0] + slope * (g_old[i] - g_lin[i]), slope
 
     def _solve_surge_yaw(self, base: tuple, drives: _Drives):
         """Surge and yaw-rate change, implicit in the soil forces: Newton passes, each
@@ -603,7 +714,7 @@ class SimCore:
         g_lin = ground
         converged = contact is None
         for _ in range(_NEWTON_PASSES):
-            du, dr, new, limited = self._solve_tracks(base, lin, g_lin, ground, others)
+            du, dr, new, limited = self._solve_tracks(base, lin, g_lin, ground, drives)
             if contact is None or all(limited):
                 converged = True
                 break
@@ -613,7 +724,7 @@ class SimCore:
                 break
             guess = predicted_speeds(lin, drives.loop_k, g_lin, g_next)
             g_lin = g_next
-            lin = linearise(contact, tuple(self.ref), g_lin, tuple(others), drives.loop_k,
+            lin = linearise(contact, drives.loop_ref, g_lin, tuple(others), drives.loop_k,
                             guess)
         if contact is not None:
             slip_p, slip_s = lin.speed_mps[0] - ground[0], lin.speed_mps[1] - ground[1]
@@ -625,9 +736,7 @@ class SimCore:
         # the soil force is nearly a step at these slips (firm sand, low speed): the tracks
         # grip; solve the step with the ground under the tracks moving at the tracks'
         # (loaded) speeds, within what the soil and the motors can give
-        if any(math.isinf(k) for k in drives.loop_k):
-            return self._grip_step(base, contact, u0, r0, others)
-        return self._loaded_grip_step(base, contact, u0, r0, others, drives.loop_k)
+        return self._grip_step(base, drives)
 
     def _follow_ground(self) -> None:
         """On the ground: take the beach's pose; the rates are the pose's change over the step."""
@@ -662,16 +771,17 @@ class SimCore:
         self.grazing = False
         self._touchdown()
 
-    def _solve_tracks(self, base: tuple, lin, g_lin: tuple, g_old: tuple, others: list):
+    def _solve_tracks(self, base: tuple, lin, g_lin: tuple, g_old: tuple, drives: _Drives):
         """Implicit surge and yaw-rate change with the soil forces linearised at ``g_lin``.
 
-        Returns (du, dr, soil force per track, which tracks the motor limits).
+        Returns (du, dr, soil force per track, which tracks the motor limits: +-1 at +-its
+        limit, else 0).
         """
         x0, n0, m_x, i_z, j_u, j_r = base
         dt, half = self.dt_s, self._half_sep
         deriv = list(lin.dforce_dground)
         force = [lin.force_n[i] + deriv[i] * (g_old[i] - g_lin[i]) for i in range(2)]
-        limited = [False, False]
+        limited = [0, 0]
         for _ in range(3):
             # [m_x - dt (j_u + Dp + Ds), -dt p (Ds - Dp); -dt p (Ds - Dp), i_z - dt (j_r + p^2
             # (Dp + Ds))] [du, dr] = dt [X + Fp + Fs, N + p (Fs - Fp)]
@@ -685,69 +795,64 @@ class SimCore:
             dr = (a11 * b2 - cross * b1) / det
             new = [force[0] + deriv[0] * (du - dr * half), force[1] + deriv[1] * (du + dr * half)]
             again = False
+            motor_map = drives.motor_map
             for i in range(2):
-                need = new[i] + others[i]
+                need = motor_map[2 * i] * (new[i] + drives.others[i]) + motor_map[2 * i + 1]
                 if not limited[i] and abs(need) > self._max_motor_n:
-                    limited[i] = True
-                    force[i] = math.copysign(self._max_motor_n, need) - others[i]
-                    deriv[i] = 0.0
+                    limited[i] = 1 if need > 0.0 else -1
+                    force[i], deriv[i] = self._at_motor_limit(
+                        i, limited[i] * self._max_motor_n, drives, g_lin, g_old)
                     again = True
             if not again:
                 break
         return du, dr, new, limited
 
-    def _grip_step(self, base: tuple, contact, u0: float, r0: float, others: list):
-        """Surge and yaw-rate change with the tracks gripping (no slip), forces capped by
-        the soil's strength and the motors' limit. Returns (du, dr, forces, limited)."""
+    def _grip_step(self, base: tuple, drives: _Drives):
+        """Surge and yaw-rate change with the tracks gripping (no slip): the ground under
+        each track moves at the track's loaded speed g_i = ref_i - c_i (F_i + o_i), c_i =
+        1/k_i the loop's compliance (0: a held track runs at its reference). A motor at its
+        limit drives its belt against the soil (a loop of compliance dt / m_eq:
+        ``_limited_ref``; without inertia its force less the friction reaches the soil); a
+        track beyond the soil's strength slides at it, the other still grips. Returns (du,
+        dr, forces, limited: +-1 at the motor's limit, _SLIDING)."""
         x0, n0, m_x, i_z, j_u, j_r = base
         dt, half = self.dt_s, self._half_sep
-        du = 0.5 * (self.ref[0] + self.ref[1]) - u0
-        dr = (self.ref[1] - self.ref[0]) / (2.0 * half) - r0
-        total = m_x * du / dt - x0 - j_u * du
-        turn = (i_z * dr / dt - n0 - j_r * dr) / half
-        want = [0.5 * (total - turn), 0.5 * (total + turn)]
-        strength = contact.strength_n()
-        limited = [False, False]
-        force = []
-        for i in range(2):
-            lo = max(-strength, -self._max_motor_n - others[i])
-            hi = min(strength, self._max_motor_n - others[i])
-            limited[i] = not lo <= want[i] <= hi
-            force.append(min(max(want[i], lo), hi))
-        if any(limited):
-            du = dt * (x0 + force[0] + force[1]) / (m_x - dt * j_u)
-            dr = dt * (n0 + (force[1] - force[0]) * half) / (i_z - dt * j_r)
+        comp = [0.0 if math.isinf(k) else 1.0 / k for k in drives.loop_k]
+        ref, other = list(drives.loop_ref), list(drives.others)
+        # du = a (x0 + F0 + F1), half dr = b (n0 / half + F1 - F0): the ground speeds' change
+        # per N is a + b of the track's own force, a - b of the other's
+        a = dt / (m_x - dt * j_u)
+        b = dt * half * half / (i_z - dt * j_r)
+        turn = b * n0 / half
+        strength = drives.contact.strength_n()
+        limited, fixed = [0, 0], [None, None]
+        for _ in range(4):
+            rhs = [ref[0] - comp[0] * other[0] - drives.ground[0] - a * x0 + turn,
+                   ref[1] - comp[1] * other[1] - drives.ground[1] - a * x0 - turn]
+            force = _grip_forces(a, b, rhs, comp, fixed)
+            again = False
+            for i in range(2):
+                if limited[i] == _SLIDING:
+                    continue
+                motor = self._loop_motor_n(i, force[i] + drives.others[i], drives)
+                if not limited[i] and abs(motor) > self._max_motor_n:
+                    limited[i] = 1 if motor > 0.0 else -1
+                    cap = limited[i] * self._max_motor_n
+                    if self._belt_inertial(drives.contact):
+                        comp[i] = 1.0 / self._belt_n_per_mps
+                        ref[i], other[i] = self._limited_ref(i, cap, drives.others[i]), 0.0
+                    else:
+                        fixed[i] = cap - drives.others[i]
+                    again = True
+                elif abs(force[i]) > strength:
+                    limited[i], fixed[i] = _SLIDING, math.copysign(strength, force[i])
+                    again = True
+            if not again:
+                break
+        force = [min(max(f, -strength), strength) for f in force]
+        du = a * (x0 + force[0] + force[1])
+        dr = b * (n0 / half + force[1] - force[0]) / half
         return du, dr, force, limited
-
-    def _loaded_grip_step(self, base: tuple, contact, u0: float, r0: float, others: list,
-                          loop_k: tuple):
-        """As _grip_step, with the tracks' speeds those of loaded speed loops:
-        F_i + o_i = k_i (ref_i - g_i), g the new ground speeds (linear, decoupled)."""
-        x0, n0, m_x, i_z, j_u, j_r = base
-        dt, half = self.dt_s, self._half_sep
-        a = [loop_k[0] * (self.ref[0] - u0 + r0 * half) - others[0],
-             loop_k[1] * (self.ref[1] - u0 - r0 * half) - others[1]]
-        k_sum = loop_k[0] + loop_k[1]
-        du = dt * (x0 + a[0] + a[1]) / (m_x - dt * j_u + dt * k_sum)
-        dr = dt * (n0 + (a[1] - a[0]) * half) / (i_z - dt * j_r + dt * k_sum * half * half)
-        force = [a[0] - loop_k[0] * (du - dr * half), a[1] - loop_k[1] * (du + dr * half)]
-        strength = contact.strength_n()
-        limited = [False, False]
-        for i in range(2):
-            lo = max(-strength, -self._max_motor_n - others[i])
-            hi = min(strength, self._max_motor_n - others[i])
-            limited[i] = not lo <= force[i] <= hi
-            force[i] = min(max(force[i], lo), hi)
-        if any(limited):
-            du = dt * (x0 + force[0] + force[1]) / (m_x - dt * j_u)
-            dr = dt * (n0 + (force[1] - force[0]) * half) / (i_z - dt * j_r)
-        return du, dr, force, limited
-
-    def _loaded_speed(self, i: int, motor_force_n: float, loop_k: float) -> float:
-        """Track speed of a speed loop (not at its current limit) giving this force, m/s."""
-        if math.isinf(loop_k):
-            return self.ref[i]
-        return self.ref[i] - motor_force_n / loop_k      # afloat too: friction, paddling
 
     def _prop_thrust_factors(self, eta: np.ndarray) -> list[float]:
         """Port and starboard thrust shares from each propeller's depth under the surface."""

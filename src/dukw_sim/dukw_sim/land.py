@@ -10,6 +10,13 @@ commanded speed exceeds what the motor can give, the track slows until the two b
 
 The force on the vehicle (a track running backwards pushes backwards) is the shared
 ``traction.track_force_n``.
+
+The belt has inertia (the motor's rotor through the reduction, the belt, its wheels):
+m_eq dv/dt = k (ref - v) - F_soil - others. Over one step, implicitly (backward Euler),
+that is a speed loop of stiffness k + m_eq/dt about the reference (k ref + m_eq/dt v0) /
+(k + m_eq/dt), v0 the belt's speed a step ago (``inertial_loop``): the soil solve below
+takes it as it takes the controller's loop, and a loaded belt relaxes with the time
+constant m_eq / k instead of jumping to its loaded speed.
 """
 from __future__ import annotations
 
@@ -26,6 +33,45 @@ _GRID = np.linspace(0.0, 1.0, 41)
 _COMPLIANCE_ITERATIONS = 60   # safeguarded Newton steps for the loaded track speed (the
                               # soil force is steep near no slip: up to ~40 bisections)
 _COMPLIANCE_TOL_N = 0.02
+
+
+def belt_equivalent_mass_kg(rotor_inertia_kg_m2: float, gear_reduction: float,
+                            sprocket_diameter_m: float, belt_mass_kg: float,
+                            wheels_inertia_kg_m2: float) -> float:
+    """One track drive's inertia reflected to the belt, kg: J_rotor (N / r)^2 + m_belt +
+    J_wheels / r^2, r the drive sprocket's radius (the wheels' inertia about their axles,
+    taken at that radius)."""
+    values = (rotor_inertia_kg_m2, gear_reduction, sprocket_diameter_m, belt_mass_kg,
+              wheels_inertia_kg_m2)
+    if not all(math.isfinite(v) for v in values) or min(values) < 0.0 \
+            or gear_reduction <= 0.0 or sprocket_diameter_m <= 0.0:
+        raise ValueError(f'belt inertia needs finite values >= 0 (reduction and sprocket '
+                         f'diameter > 0), got {values}')
+    radius_m = sprocket_diameter_m / 2.0
+    return (rotor_inertia_kg_m2 * (gear_reduction / radius_m) ** 2 + belt_mass_kg
+            + wheels_inertia_kg_m2 / radius_m ** 2)
+
+
+def belt_mass_kg(mass_per_area_kgpm2: float, width_m: float, contact_length_m: float,
+                 sprocket_diameter_m: float) -> float:
+    """A track belt's mass, kg: its areal mass x width x length, the length that of a belt
+    around two sprockets of the drive's diameter at the ends of the contact, 2 l + pi d."""
+    return mass_per_area_kgpm2 * width_m * (2.0 * contact_length_m
+                                            + math.pi * sprocket_diameter_m)
+
+
+def inertial_loop(stiffness_n_per_mps: float, ref_mps: float, belt_mps: float,
+                  inertia_n_per_mps: float) -> tuple[float, float]:
+    """A speed loop and its belt's inertia over one implicit step, as one loop.
+
+    m (v - v0) / dt = k (ref - v) - F  <=>  F = (k + m/dt) (ref' - v) with ref' = (k ref +
+    m/dt v0) / (k + m/dt). ``inertia_n_per_mps`` = m/dt. Returns (k + m/dt, ref'); a loop
+    that holds its speed (k infinite) stays one: (inf, ref).
+    """
+    if math.isinf(stiffness_n_per_mps) or inertia_n_per_mps == 0.0:
+        return stiffness_n_per_mps, ref_mps
+    k = stiffness_n_per_mps + inertia_n_per_mps
+    return k, (stiffness_n_per_mps * ref_mps + inertia_n_per_mps * belt_mps) / k
 
 
 @dataclass(frozen=True)

@@ -99,6 +99,9 @@ class LandParams:
     speed_loop_time_constant_s: float
     speed_loop_accel_mps2: float
     speed_loop_droop_mps_per_kn: float
+    motor_rotor_inertia_kg_m2: float
+    belt_mass_per_area_kgpm2: float
+    track_wheels_inertia_kg_m2: float
     port_speed_deficit_pct: float
     breakaway_friction_ratio: float
     rolling_resistance_coeff: float
@@ -113,6 +116,10 @@ class LandParams:
         if self.speed_loop_droop_mps_per_kn < 0.0 or self.lateral_damping_n_per_mps < 0.0:
             raise ConfigError('land.speed_loop_droop_mps_per_kn and '
                               'land.lateral_damping_n_per_mps must be >= 0')
+        if min(self.motor_rotor_inertia_kg_m2, self.belt_mass_per_area_kgpm2,
+               self.track_wheels_inertia_kg_m2) < 0.0:
+            raise ConfigError('land.motor_rotor_inertia_kg_m2, land.belt_mass_per_area_kgpm2 '
+                              'and land.track_wheels_inertia_kg_m2 must be >= 0')
 
 
 @dataclass(frozen=True)
