@@ -65,6 +65,9 @@ class ContactModel:
         self._volumes: dict[tuple[float, ...], float] = {}
         self._submersion: tuple[tuple[float, ...], tuple[float, float]] | None = None
         self._cos_slope = (math.nan, math.nan)    # (slope, its cos), rad
+        # (weight, saturation, soil) -> the tracks' patch (``_patch``)
+        self._patch_key: tuple | None = None
+        self._patch_value: traction.TrackPatch | None = None
         # the heave mass and damping of the hulls' section about the float line (the simulator's)
         heave = heave_constants(body, settings.heave_natural_hz, settings.heave_damping_ratio)
         self.heave_mass_kg = heave.mass_kg
@@ -82,6 +85,8 @@ class ContactModel:
         self.heave_velocity_mps = 0.0
         self.force = [ForceSmoother(st.force_process_n_per_s, st.force_measurement_n)
                       for _ in range(2)]
+        # per track: ((status, smoothed force), its soil force) last worked out
+        self._soil_forces: list[tuple[tuple, float]] = [((None, math.nan), math.nan)] * 2
 
     # ------------------------------------------------------------------ IMU
     def heave_accel_mps2(self, imu: ImuSample | None,
@@ -145,10 +150,16 @@ class ContactModel:
         force = self.force[k].force_n
         if tracks is None or not math.isfinite(force):
             return math.nan
+        key = (tracks, force)
+        known = self._soil_forces[k]
+        if known[0] == key:              # the same status and smoothed force: the same value
+            return known[1]
         speed = (tracks.port, tracks.stbd)[k].speed_mps
         drive = self.vehicle.drivetrain
         fade = math.tanh(speed / drive.friction_fade_mps)
-        return force - drive.track_friction_n(k == 0) * fade
+        value = force - drive.track_friction_n(k == 0) * fade
+        self._soil_forces[k] = (key, value)
+        return value
 
     def tracks_pushing(self, tracks: DriveStatus | None, tracks_fresh: bool) -> bool:
         """Both tracks push or brake the vehicle harder than water could (paddling belts,
@@ -300,7 +311,17 @@ class ContactModel:
                       saturation: float) -> float:
         """The shared traction model's soil force of one track carrying ``weight_n`` on sand
         this much saturated (the saturated sand's pore suction, ``vehicle.saturated_sand``), N."""
-        return float(traction.track_force_n(track_mps, ground_mps, weight_n, self.soil,
-                                            self.track_area_m2,
-                                            self.vehicle.body.track_contact_length_m,
-                                            self.vehicle.saturated_sand, saturation))
+        return traction.track_force_f(self._patch(weight_n, saturation), track_mps, ground_mps)
+
+    def _patch(self, weight_n: float, saturation: float) -> traction.TrackPatch:
+        """One track's patch at this weight and saturation on the present soil
+        (``traction.track_force_f``: the same bits as ``track_force_n``), remembered while
+        they hold: both tracks and the force's probes ask for the same one."""
+        key = (weight_n, saturation, self.soil)
+        if self._patch_key != key:
+            self._patch_key = key
+            self._patch_value = traction.TrackPatch(
+                weight_n, self.soil, self.track_area_m2,
+                self.vehicle.body.track_contact_length_m, self.vehicle.saturated_sand,
+                saturation)
+        return self._patch_value

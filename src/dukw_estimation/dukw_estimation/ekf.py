@@ -117,6 +117,11 @@ class MotionEkf:
         # process noise variance rates (diagonal of Q / dt) by acceleration noise: the noise
         # is frozen, and the predictions use one or two acceleration noises
         self._q_rates: dict[float, np.ndarray] = {}
+        # the frozen noise's constants the prediction reads
+        self._wave_omega_rps, self._wave_damping = noise.wave_omega_rps, noise.wave_damping
+        self._gps_bias_tau_s = noise.gps_bias_tau_s
+        self._accel_bias_tau_s = noise.accel_bias_tau_s
+        self._accel_mps2 = noise.accel_mps2
 
     def predict(self, dt: float, accel_body: tuple[float, float] | None = None,
                 drive_target: tuple[float, float, float] | None = None,
@@ -130,7 +135,9 @@ class MotionEkf:
         if dt <= 0.0:
             return
         x = self.x
-        yaw, u, v, r = x[_YAW], x[_U], x[_V], x[_R]
+        # the state as floats: the same IEEE arithmetic as numpy's scalars, without their
+        # per-operation cost (the same bits)
+        (_, _, yaw, u, v, r, _, _, eta, eta_rate, _, _, _, abx, aby) = x.tolist()
         c, s = math.cos(yaw), math.sin(yaw)
         rel = yaw - self.seaward_yaw_rad
         cr, sr = math.cos(rel), math.sin(rel)
@@ -151,33 +158,31 @@ class MotionEkf:
         x[_YAW] = wrap_angle(yaw + r * dt)
         F[_YAW, _R] = dt
         if accel_body is not None:
-            x[_U] += (accel_body[0] - x[_ABX]) * dt
-            x[_V] += (accel_body[1] - x[_ABY]) * dt
+            x[_U] = u + (accel_body[0] - abx) * dt
+            x[_V] = v + (accel_body[1] - aby) * dt
             F[_U, _ABX] = F[_V, _ABY] = -dt
         elif drive_target is not None:
             u_t, r_t, tau = drive_target
             k = min(dt / tau, 1.0)
-            x[_U] += (u_t - u) * k
-            x[_V] -= v * k
-            x[_R] += (r_t - r) * k
+            x[_U] = u + (u_t - u) * k
+            x[_V] = v - v * k
+            x[_R] = r + (r_t - r) * k
             F[_U, _U] = F[_V, _V] = F[_R, _R] = 1.0 - k
-        n = self.noise
-        w, z = n.wave_omega_rps, n.wave_damping
-        eta, eta_rate = x[_ETA], x[_ETA_RATE]
+        w, z = self._wave_omega_rps, self._wave_damping
         x[_ETA] = eta + eta_rate * dt
         x[_ETA_RATE] = eta_rate + (-w * w * eta - 2.0 * z * w * eta_rate) * dt
         F[_ETA, _ETA_RATE] = dt
         F[_ETA_RATE, _ETA] = -w * w * dt
         F[_ETA_RATE, _ETA_RATE] = 1.0 - 2.0 * z * w * dt
-        decay = 1.0 - dt / n.gps_bias_tau_s
+        decay = 1.0 - dt / self._gps_bias_tau_s
         x[_GBE] *= decay
         x[_GBN] *= decay
         F[_GBE, _GBE] = F[_GBN, _GBN] = decay
-        leak = 1.0 - dt / n.accel_bias_tau_s
-        x[_ABX] *= leak
-        x[_ABY] *= leak
+        leak = 1.0 - dt / self._accel_bias_tau_s
+        x[_ABX] = abx * leak
+        x[_ABY] = aby * leak
         F[_ABX, _ABX] = F[_ABY, _ABY] = leak
-        accel = n.accel_mps2 if accel_noise_mps2 is None else accel_noise_mps2
+        accel = self._accel_mps2 if accel_noise_mps2 is None else accel_noise_mps2
         q_rate = self._q_rates.get(accel)
         if q_rate is None:
             q_rate = self._q_rates[accel] = self._q_rate(accel)

@@ -45,6 +45,8 @@ class Estimator:
         self.surface = SurfaceObserver(vehicle, settings, self.contact)
         self.counters: dict[str, dict[Outcome, int]] = {s: defaultdict(int) for s in SENSORS}
         self.rates = {s: RateCounter() for s in SENSORS}
+        #: sensor -> fused (the settings are frozen: looked up once)
+        self._enabled = {s: settings.sensor_enabled(s) for s in SENSORS}
         self.reset()
 
     # ------------------------------------------------------------------ state
@@ -122,15 +124,17 @@ class Estimator:
     def _admit(self, sensor: str, t_s: float, values: tuple[float, ...]) -> Outcome | None:
         """Common checks; returns a rejection outcome, or None when the sample may be used
         (the filter then predicted to its time)."""
-        if not self.settings.sensor_enabled(sensor):
+        if not self._enabled[sensor]:
             return self._count(sensor, Outcome.IGNORED)
-        if not all(math.isfinite(v) for v in (t_s, *values)):
+        if not (math.isfinite(t_s) and all(map(math.isfinite, values))):
             return self._count(sensor, Outcome.REJECTED_NAN)
-        too_old = self.t_s is not None and t_s < self.t_s - self.settings.max_lag_s
-        if t_s <= self.motion_filter.last_t[sensor] or too_old:
+        motion = self.motion_filter
+        now_s = motion.t_s
+        too_old = now_s is not None and t_s < now_s - self.settings.max_lag_s
+        if t_s <= motion.last_t[sensor] or too_old:
             return self._count(sensor, Outcome.REJECTED_OUT_OF_ORDER)
-        self.motion_filter.predict_to(t_s, self.contact.fraction)
-        self.motion_filter.last_t[sensor] = t_s
+        motion.predict_to(t_s, self.contact.fraction)
+        motion.last_t[sensor] = t_s
         self.rates[sensor].tick(t_s)
         return None
 
