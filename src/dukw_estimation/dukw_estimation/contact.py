@@ -181,44 +181,48 @@ class ContactModel:
         last = self._submersion
         if last is not None and last[0] == key:
             return last[1]
-        body = self.vehicle.body
-        h2 = buoyancy.submerged_length_m(waterline, self.slope_rad, body.hull_clearance_m,
-                                         self.hull_bow_x_m, self.hull_stern_x_m, eta,
-                                         heading_cos)
-        value = (h2, self.grounded_volume_m3(waterline, eta, heading_cos))
+        line = self._bottom_line(waterline, eta, heading_cos)
+        h2 = buoyancy.submerged_length_of_line_m(*line, self.hull_bow_x_m, self.hull_stern_x_m)
+        value = (h2, self.grounded_volume_m3(waterline, eta, heading_cos, line))
         self._submersion = (key, value)
         return value
 
+    def _bottom_line(self, waterline_distance_m: float, surface_m: float,
+                     heading_cos: float) -> tuple[float, float]:
+        """``buoyancy.bottom_depth_line`` on the estimated slope: the water over the hulls'
+        bottom line at base_link and its gradient along the body."""
+        return buoyancy.bottom_depth_line(waterline_distance_m, self.slope_rad,
+                                          self.vehicle.body.hull_clearance_m, surface_m,
+                                          heading_cos)
+
     def grounded_volume_m3(self, waterline_distance_m: float, surface_m: float,
-                           heading_cos: float) -> float:
+                           heading_cos: float, line: tuple[float, float] | None = None
+                           ) -> float:
         """The hulls' volume under the surface ``surface_m`` with the waterline this far,
         on the estimated slope, m^3 (``buoyancy.grounded_volume_m3``, remembered by its
-        inputs: the same value, computed once)."""
+        inputs: the same value, computed once). ``line``: their ``_bottom_line`` if the
+        caller has it."""
         key = (waterline_distance_m, surface_m, heading_cos, self.slope_rad)
         volumes = self._volumes
         volume = volumes.get(key)
         if volume is None:
             if len(volumes) >= VOLUME_CACHE_SIZE:
                 volumes.clear()
-            body = self.vehicle.body
-            if self._dry(waterline_distance_m, surface_m, heading_cos):
+            if line is None:
+                line = self._bottom_line(waterline_distance_m, surface_m, heading_cos)
+            if self._dry(*line):
                 volume = volumes[key] = 0.0
             else:
-                volume = volumes[key] = buoyancy.grounded_volume_m3(
-                    waterline_distance_m, self.slope_rad, body.hull_clearance_m,
-                    self.hull_bow_x_m, self.hull_stern_x_m, body.hull_radius_m, surface_m,
-                    heading_cos, self.section)
+                volume = volumes[key] = buoyancy.grounded_volume_of_line_m3(
+                    *line, self.hull_bow_x_m, self.hull_stern_x_m, self.section)
         return volume
 
-    def _dry(self, waterline_distance_m: float, surface_m: float, heading_cos: float) -> bool:
-        """The surface clearly (``DRY_MARGIN_M``) below both ends of the hulls' bottom line:
-        ``buoyancy.grounded_volume_m3`` would integrate nothing and return 0.0 (on the sand,
-        most samples); computed with its own bottom line."""
-        depth0, gradient = buoyancy._bottom_depth_line(   # noqa: SLF001 - the same line
-            waterline_distance_m, self.slope_rad, self.vehicle.body.hull_clearance_m,
-            surface_m, heading_cos)
-        deepest = max(depth0 + gradient * self.hull_bow_x_m,
-                      depth0 + gradient * self.hull_stern_x_m)
+    def _dry(self, depth0_m: float, gradient: float) -> bool:
+        """The surface clearly (``DRY_MARGIN_M``) below both ends of the hulls' bottom line
+        (``_bottom_line``): ``buoyancy.grounded_volume_m3`` would integrate nothing and
+        return 0.0 (on the sand, most samples)."""
+        deepest = max(depth0_m + gradient * self.hull_bow_x_m,
+                      depth0_m + gradient * self.hull_stern_x_m)
         return deepest < -DRY_MARGIN_M
 
     def surface_volume_m3(self, x: np.ndarray, raise_m: float = 0.0) -> float:
