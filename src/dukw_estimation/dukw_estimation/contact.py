@@ -60,6 +60,7 @@ class ContactModel:
         # the IMU says
         self.sure_float_m3 = 0.5 * (body.displaced_volume_m3 + self.max_volume_m3)
         self.track_area_m2 = body.track_width_m * body.track_contact_length_m
+        self.displaced_m3 = body.displaced_volume_m3     # afloat in calm water (constant)
         # (waterline distance, surface, heading cos, slope) -> grounded volume, m^3; and the
         # last submersion's inputs and (h2, volume)
         self._volumes: dict[tuple[float, ...], float] = {}
@@ -175,8 +176,8 @@ class ContactModel:
     # ------------------------------------------------------------------ submersion
     def submersion(self, x: np.ndarray) -> tuple[float, float]:
         """(h2, the volume the estimated surface puts under water on the slope), m, m^3."""
-        waterline, eta = x[_S], x[_ETA]
-        heading_cos = math.cos(x[_YAW] - self.settings.seaward_yaw_rad)
+        waterline, eta = x.item(_S), x.item(_ETA)       # floats: the same values
+        heading_cos = math.cos(x.item(_YAW) - self.settings.seaward_yaw_rad)
         key = (waterline, eta, heading_cos, self.slope_rad)
         last = self._submersion
         if last is not None and last[0] == key:
@@ -234,8 +235,7 @@ class ContactModel:
         """Weight on the tracks, N: none afloat; on the sand the hulls do not float."""
         if afloat:
             return 0.0
-        return self._effective_weight_n(min(grounded_volume_m3,
-                                            self.vehicle.body.displaced_volume_m3))
+        return self._effective_weight_n(min(grounded_volume_m3, self.displaced_m3))
 
     def _effective_weight_n(self, volume_m3: float) -> float:
         """``traction.effective_weight_n`` on the estimated slope for one volume, written
@@ -260,7 +260,7 @@ class ContactModel:
         acceleration); floating, it rolls, pitches and heaves with the waves. Both tracks
         pushing hard (``tracks_pushing``) mean the sand.
         """
-        displaced = self.vehicle.body.displaced_volume_m3
+        displaced = self.displaced_m3
         if pushing:
             return False
         limit = displaced * (TOUCHDOWN_SHARE if self.afloat else 1.0)
