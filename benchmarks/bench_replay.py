@@ -137,13 +137,27 @@ measured: the estimator alone (the 'bound' line) is ~110 ms CPU of land_to_sea's
 without a cheaper estimator; of the rest: rosbags' CDR decoding (~24 ms, ~20 % here) and
 MCAP reading (~11 ms, ~11 % here), the estimator's message conversions and rows, the
 drive controller core (~13 ms) and its conversions, the mode manager, the comparisons
-and the replay loop."""
+and the replay loop.
+Then (branch i16g, 2026-11-27) the estimator: bit-identical steps first (the tracks' Wong
+force through traction.track_force_f with its patch remembered, the hulls' bottom line once
+per state, the state read as floats, settings and per-status soil forces looked up once),
+then the EKF's predict and updates as numba kernels (dukw_estimation.ekf_kernels; the
+covariance's last bits change, golden bags regenerated). Interleaved rounds against 8ac9fe6
+(16:25-16:29 UTC, CPU clock, best of 5 per run, five rounds, load average 4.9-5.6), medians:
+land_circle 28.6 k -> 31.8 k (bit-identical steps) -> 35.6 k msg/s (numba), land_to_sea
+26.8 k -> 32.0 k -> 36.2 k, sea_to_land 26.7 k -> 31.1 k -> 35.7 k. Not met (>= 50 k): of
+land_to_sea's ~155 ms, reading + decoding + the loop with cores that do nothing are ~35 ms
+(rosbags'), the estimator ~50 ms, its adapter (conversions, rows, comparisons) ~25 ms, the
+drive controller ~21 ms, the mode manager ~4 ms."""
 
 ESTIMATOR_PROFILE_HEADER = """cProfile of the estimator alone (EkfRunner, odometry and
 traction read per estimate, as the replay does) on tests/golden/land_to_sea's inputs,
 decoded beforehand:
   python benchmarks/bench_replay.py --profile-estimator benchmarks/profiles/estimator_alone.txt
-(branch ekfperf, issue 16) Per message class on the CPU clock see the 'bound' lines."""
+(branch ekfperf, issue 16) Per message class on the CPU clock see the 'bound' lines.
+(branch i16g, 2026-11-27) The EKF's predict and updates are numba kernels (ekf_kernels: one
+call each, ~1-1.5 us) and the traction query and submersion work on floats: the estimator
+alone on land_to_sea ~91 -> ~50 ms CPU."""
 
 
 def main() -> None:

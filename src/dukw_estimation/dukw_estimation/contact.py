@@ -60,11 +60,15 @@ class ContactModel:
         # the IMU says
         self.sure_float_m3 = 0.5 * (body.displaced_volume_m3 + self.max_volume_m3)
         self.track_area_m2 = body.track_width_m * body.track_contact_length_m
+        self.displaced_m3 = body.displaced_volume_m3     # afloat in calm water (constant)
         # (waterline distance, surface, heading cos, slope) -> grounded volume, m^3; and the
         # last submersion's inputs and (h2, volume)
         self._volumes: dict[tuple[float, ...], float] = {}
         self._submersion: tuple[tuple[float, ...], tuple[float, float]] | None = None
         self._cos_slope = (math.nan, math.nan)    # (slope, its cos), rad
+        # (weight, saturation, soil) -> the tracks' patch (``_patch``)
+        self._patch_key: tuple | None = None
+        self._patch_value: traction.TrackPatch | None = None
         # the heave mass and damping of the hulls' section about the float line (the simulator's)
         heave = heave_constants(body, settings.heave_natural_hz, settings.heave_damping_ratio)
         self.heave_mass_kg = heave.mass_kg
@@ -82,6 +86,8 @@ class ContactModel:
         self.heave_velocity_mps = 0.0
         self.force = [ForceSmoother(st.force_process_n_per_s, st.force_measurement_n)
                       for _ in range(2)]
+        # per track: ((status, smoothed force), its soil force) last worked out
+        self._soil_forces: list[tuple[tuple, float]] = [((None, math.nan), math.nan)] * 2
 
     # ------------------------------------------------------------------ IMU
     def heave_accel_mps2(self, imu: ImuSample | None,
@@ -145,10 +151,16 @@ class ContactModel:
         force = self.force[k].force_n
         if tracks is None or not math.isfinite(force):
             return math.nan
+        key = (tracks, force)
+        known = self._soil_forces[k]
+        if known[0] == key:              # the same status and smoothed force: the same value
+            return known[1]
         speed = (tracks.port, tracks.stbd)[k].speed_mps
         drive = self.vehicle.drivetrain
         fade = math.tanh(speed / drive.friction_fade_mps)
-        return force - drive.track_friction_n(k == 0) * fade
+        value = force - drive.track_friction_n(k == 0) * fade
+        self._soil_forces[k] = (key, value)
+        return value
 
     def tracks_pushing(self, tracks: DriveStatus | None, tracks_fresh: bool) -> bool:
         """Both tracks push or brake the vehicle harder than water could (paddling belts,
@@ -164,50 +176,54 @@ class ContactModel:
     # ------------------------------------------------------------------ submersion
     def submersion(self, x: np.ndarray) -> tuple[float, float]:
         """(h2, the volume the estimated surface puts under water on the slope), m, m^3."""
-        waterline, eta = x[_S], x[_ETA]
-        heading_cos = math.cos(x[_YAW] - self.settings.seaward_yaw_rad)
+        waterline, eta = x.item(_S), x.item(_ETA)       # floats: the same values
+        heading_cos = math.cos(x.item(_YAW) - self.settings.seaward_yaw_rad)
         key = (waterline, eta, heading_cos, self.slope_rad)
         last = self._submersion
         if last is not None and last[0] == key:
             return last[1]
-        body = self.vehicle.body
-        h2 = buoyancy.submerged_length_m(waterline, self.slope_rad, body.hull_clearance_m,
-                                         self.hull_bow_x_m, self.hull_stern_x_m, eta,
-                                         heading_cos)
-        value = (h2, self.grounded_volume_m3(waterline, eta, heading_cos))
+        line = self._bottom_line(waterline, eta, heading_cos)
+        h2 = buoyancy.submerged_length_of_line_m(*line, self.hull_bow_x_m, self.hull_stern_x_m)
+        value = (h2, self.grounded_volume_m3(waterline, eta, heading_cos, line))
         self._submersion = (key, value)
         return value
 
+    def _bottom_line(self, waterline_distance_m: float, surface_m: float,
+                     heading_cos: float) -> tuple[float, float]:
+        """``buoyancy.bottom_depth_line`` on the estimated slope: the water over the hulls'
+        bottom line at base_link and its gradient along the body."""
+        return buoyancy.bottom_depth_line(waterline_distance_m, self.slope_rad,
+                                          self.vehicle.body.hull_clearance_m, surface_m,
+                                          heading_cos)
+
     def grounded_volume_m3(self, waterline_distance_m: float, surface_m: float,
-                           heading_cos: float) -> float:
+                           heading_cos: float, line: tuple[float, float] | None = None
+                           ) -> float:
         """The hulls' volume under the surface ``surface_m`` with the waterline this far,
         on the estimated slope, m^3 (``buoyancy.grounded_volume_m3``, remembered by its
-        inputs: the same value, computed once)."""
+        inputs: the same value, computed once). ``line``: their ``_bottom_line`` if the
+        caller has it."""
         key = (waterline_distance_m, surface_m, heading_cos, self.slope_rad)
         volumes = self._volumes
         volume = volumes.get(key)
         if volume is None:
             if len(volumes) >= VOLUME_CACHE_SIZE:
                 volumes.clear()
-            body = self.vehicle.body
-            if self._dry(waterline_distance_m, surface_m, heading_cos):
+            if line is None:
+                line = self._bottom_line(waterline_distance_m, surface_m, heading_cos)
+            if self._dry(*line):
                 volume = volumes[key] = 0.0
             else:
-                volume = volumes[key] = buoyancy.grounded_volume_m3(
-                    waterline_distance_m, self.slope_rad, body.hull_clearance_m,
-                    self.hull_bow_x_m, self.hull_stern_x_m, body.hull_radius_m, surface_m,
-                    heading_cos, self.section)
+                volume = volumes[key] = buoyancy.grounded_volume_of_line_m3(
+                    *line, self.hull_bow_x_m, self.hull_stern_x_m, self.section)
         return volume
 
-    def _dry(self, waterline_distance_m: float, surface_m: float, heading_cos: float) -> bool:
-        """The surface clearly (``DRY_MARGIN_M``) below both ends of the hulls' bottom line:
-        ``buoyancy.grounded_volume_m3`` would integrate nothing and return 0.0 (on the sand,
-        most samples); computed with its own bottom line."""
-        depth0, gradient = buoyancy._bottom_depth_line(   # noqa: SLF001 - the same line
-            waterline_distance_m, self.slope_rad, self.vehicle.body.hull_clearance_m,
-            surface_m, heading_cos)
-        deepest = max(depth0 + gradient * self.hull_bow_x_m,
-                      depth0 + gradient * self.hull_stern_x_m)
+    def _dry(self, depth0_m: float, gradient: float) -> bool:
+        """The surface clearly (``DRY_MARGIN_M``) below both ends of the hulls' bottom line
+        (``_bottom_line``): ``buoyancy.grounded_volume_m3`` would integrate nothing and
+        return 0.0 (on the sand, most samples)."""
+        deepest = max(depth0_m + gradient * self.hull_bow_x_m,
+                      depth0_m + gradient * self.hull_stern_x_m)
         return deepest < -DRY_MARGIN_M
 
     def surface_volume_m3(self, x: np.ndarray, raise_m: float = 0.0) -> float:
@@ -219,8 +235,7 @@ class ContactModel:
         """Weight on the tracks, N: none afloat; on the sand the hulls do not float."""
         if afloat:
             return 0.0
-        return self._effective_weight_n(min(grounded_volume_m3,
-                                            self.vehicle.body.displaced_volume_m3))
+        return self._effective_weight_n(min(grounded_volume_m3, self.displaced_m3))
 
     def _effective_weight_n(self, volume_m3: float) -> float:
         """``traction.effective_weight_n`` on the estimated slope for one volume, written
@@ -245,7 +260,7 @@ class ContactModel:
         acceleration); floating, it rolls, pitches and heaves with the waves. Both tracks
         pushing hard (``tracks_pushing``) mean the sand.
         """
-        displaced = self.vehicle.body.displaced_volume_m3
+        displaced = self.displaced_m3
         if pushing:
             return False
         limit = displaced * (TOUCHDOWN_SHARE if self.afloat else 1.0)
@@ -300,7 +315,17 @@ class ContactModel:
                       saturation: float) -> float:
         """The shared traction model's soil force of one track carrying ``weight_n`` on sand
         this much saturated (the saturated sand's pore suction, ``vehicle.saturated_sand``), N."""
-        return float(traction.track_force_n(track_mps, ground_mps, weight_n, self.soil,
-                                            self.track_area_m2,
-                                            self.vehicle.body.track_contact_length_m,
-                                            self.vehicle.saturated_sand, saturation))
+        return traction.track_force_f(self._patch(weight_n, saturation), track_mps, ground_mps)
+
+    def _patch(self, weight_n: float, saturation: float) -> traction.TrackPatch:
+        """One track's patch at this weight and saturation on the present soil
+        (``traction.track_force_f``: the same bits as ``track_force_n``), remembered while
+        they hold: both tracks and the force's probes ask for the same one."""
+        key = (weight_n, saturation, self.soil)
+        if self._patch_key != key:
+            self._patch_key = key
+            self._patch_value = traction.TrackPatch(
+                weight_n, self.soil, self.track_area_m2,
+                self.vehicle.body.track_contact_length_m, self.vehicle.saturated_sand,
+                saturation)
+        return self._patch_value

@@ -28,6 +28,7 @@ from enum import Enum, IntEnum
 import numpy as np
 
 from dukw_common.geometry import wrap_angle
+from dukw_estimation import ekf_kernels as kernels
 
 
 class Idx(IntEnum):
@@ -67,6 +68,8 @@ WATER_SURFACE_STATES = np.array([1.0 if i in (Idx.S, Idx.ETA, Idx.ETA_RATE) else
                                  for i in Idx])
 #: A sounding afloat mixes the wave with the vehicle's heave: it may correct s only.
 WATERLINE_STATE = np.array([1.0 if i == Idx.S else 0.0 for i in Idx])
+#: ``update_scalar`` without a mask (the kernel's argument when ``only`` is None)
+_NO_MASK = np.ones(N_STATES)
 
 
 class Outcome(Enum):
@@ -117,6 +120,11 @@ class MotionEkf:
         # process noise variance rates (diagonal of Q / dt) by acceleration noise: the noise
         # is frozen, and the predictions use one or two acceleration noises
         self._q_rates: dict[float, np.ndarray] = {}
+        # the frozen noise's constants the prediction reads
+        self._wave_omega_rps, self._wave_damping = noise.wave_omega_rps, noise.wave_damping
+        self._gps_bias_tau_s = noise.gps_bias_tau_s
+        self._accel_bias_tau_s = noise.accel_bias_tau_s
+        self._accel_mps2 = noise.accel_mps2
 
     def predict(self, dt: float, accel_body: tuple[float, float] | None = None,
                 drive_target: tuple[float, float, float] | None = None,
@@ -129,61 +137,20 @@ class MotionEkf:
         """
         if dt <= 0.0:
             return
-        x = self.x
-        yaw, u, v, r = x[_YAW], x[_U], x[_V], x[_R]
-        c, s = math.cos(yaw), math.sin(yaw)
-        rel = yaw - self.seaward_yaw_rad
-        cr, sr = math.cos(rel), math.sin(rel)
-        inv_cos = 1.0 / math.cos(slope_rad)
-        F = self._eye.copy()
-        x[_X] += (u * c - v * s) * dt
-        x[_Y] += (u * s + v * c) * dt
-        F[_X, _YAW] = (-u * s - v * c) * dt
-        F[_X, _U] = c * dt
-        F[_X, _V] = -s * dt
-        F[_Y, _YAW] = (u * c - v * s) * dt
-        F[_Y, _U] = s * dt
-        F[_Y, _V] = c * dt
-        x[_S] += (u * cr - v * sr) * inv_cos * dt
-        F[_S, _YAW] = (-u * sr - v * cr) * inv_cos * dt
-        F[_S, _U] = cr * inv_cos * dt
-        F[_S, _V] = -sr * inv_cos * dt
-        x[_YAW] = wrap_angle(yaw + r * dt)
-        F[_YAW, _R] = dt
         if accel_body is not None:
-            x[_U] += (accel_body[0] - x[_ABX]) * dt
-            x[_V] += (accel_body[1] - x[_ABY]) * dt
-            F[_U, _ABX] = F[_V, _ABY] = -dt
+            mode, inputs = kernels.ACCEL, (accel_body[0], accel_body[1], 0.0)
         elif drive_target is not None:
-            u_t, r_t, tau = drive_target
-            k = min(dt / tau, 1.0)
-            x[_U] += (u_t - u) * k
-            x[_V] -= v * k
-            x[_R] += (r_t - r) * k
-            F[_U, _U] = F[_V, _V] = F[_R, _R] = 1.0 - k
-        n = self.noise
-        w, z = n.wave_omega_rps, n.wave_damping
-        eta, eta_rate = x[_ETA], x[_ETA_RATE]
-        x[_ETA] = eta + eta_rate * dt
-        x[_ETA_RATE] = eta_rate + (-w * w * eta - 2.0 * z * w * eta_rate) * dt
-        F[_ETA, _ETA_RATE] = dt
-        F[_ETA_RATE, _ETA] = -w * w * dt
-        F[_ETA_RATE, _ETA_RATE] = 1.0 - 2.0 * z * w * dt
-        decay = 1.0 - dt / n.gps_bias_tau_s
-        x[_GBE] *= decay
-        x[_GBN] *= decay
-        F[_GBE, _GBE] = F[_GBN, _GBN] = decay
-        leak = 1.0 - dt / n.accel_bias_tau_s
-        x[_ABX] *= leak
-        x[_ABY] *= leak
-        F[_ABX, _ABX] = F[_ABY, _ABY] = leak
-        accel = n.accel_mps2 if accel_noise_mps2 is None else accel_noise_mps2
+            mode, inputs = kernels.DRIVE, drive_target
+        else:
+            mode, inputs = kernels.HOLD, (0.0, 0.0, 0.0)
+        accel = self._accel_mps2 if accel_noise_mps2 is None else accel_noise_mps2
         q_rate = self._q_rates.get(accel)
         if q_rate is None:
             q_rate = self._q_rates[accel] = self._q_rate(accel)
-        P = F @ self.P @ F.T
-        P.reshape(-1)[::N_STATES + 1] += q_rate * dt     # the diagonal (a view of P)
-        self.P = P
+        kernels.predict(self.x, self.P, q_rate, dt, mode, float(inputs[0]), float(inputs[1]),
+                        float(inputs[2]), self.seaward_yaw_rad, 1.0 / math.cos(slope_rad),
+                        self._wave_omega_rps, self._wave_damping, self._gps_bias_tau_s,
+                        self._accel_bias_tau_s)
 
     def _q_rate(self, accel_mps2: float) -> np.ndarray:
         """The diagonal of the process noise per second with this acceleration noise."""
@@ -199,14 +166,18 @@ class MotionEkf:
                gate: float, angle_rows: tuple[int, ...] = ()) -> Outcome:
         """Gated EKF update. The whole vector is gated on its Mahalanobis distance (rejected
         above ``gate``); with a diagonal R it is then applied row by row (exact, and cheaper
-        than the matrix form), else in Joseph form."""
+        than the matrix form; a 2-D one in one compiled call, ``ekf_kernels.update_rows_2d``),
+        else in Joseph form."""
         y = np.asarray(z, dtype=float) - hx
         for row in angle_rows:
             y[row] = wrap_angle(y[row])
+        if H.shape[0] == 2 and R[0, 1] == 0.0 and R[1, 0] == 0.0:    # the DGPS's, the tracks'
+            accepted = kernels.update_rows_2d(self.x, self.P, float(y[0]), float(y[1]),
+                                              np.ascontiguousarray(H, dtype=float),
+                                              float(R[0, 0]), float(R[1, 1]), float(gate))
+            return Outcome.ACCEPTED if accepted else Outcome.REJECTED_OUTLIER
         PHt = self.P @ H.T
         S = H @ PHt + R
-        if S.shape == (2, 2) and R[0, 1] == 0.0 and R[1, 0] == 0.0:
-            return self._update_rows_2d(y, H, R, S, gate)
         try:
             S_inv = np.linalg.inv(S)
         except np.linalg.LinAlgError:
@@ -228,26 +199,6 @@ class MotionEkf:
         self.P = I_KH @ self.P @ I_KH.T + K @ R @ K.T
         return Outcome.ACCEPTED
 
-    def _update_rows_2d(self, y: np.ndarray, H: np.ndarray, R: np.ndarray, S: np.ndarray,
-                        gate: float) -> Outcome:
-        """``update`` of a 2-D measurement with a diagonal R (the DGPS's, the tracks'): the
-        gate's Mahalanobis distance from the 2x2 inverse in closed form (a singular S is
-        rejected, as ``inv`` would), then the two rows in turn."""
-        a, b, c, d = float(S[0, 0]), float(S[0, 1]), float(S[1, 0]), float(S[1, 1])
-        det = a * d - b * c
-        if det == 0.0:
-            return Outcome.REJECTED_OUTLIER
-        y0, y1 = float(y[0]), float(y[1])
-        d2 = (y0 * (d * y0 - b * y1) + y1 * (a * y1 - c * y0)) / det
-        if not math.isfinite(d2) or d2 > gate * gate:
-            return Outcome.REJECTED_OUTLIER
-        x_start = self.x.copy()
-        self.update_scalar(y0, 0.0, H[0], float(R[0, 0]), math.inf)
-        # the second row's residual moves with the state the first row corrected
-        residual = y[1] - float(H[1] @ (self.x - x_start))
-        self.update_scalar(residual, 0.0, H[1], float(R[1, 1]), math.inf)
-        return Outcome.ACCEPTED
-
     def update_scalar(self, z: float, hx: float, h: np.ndarray, var: float,
                       gate: float, angle: bool = False,
                       only: np.ndarray | None = None) -> Outcome:
@@ -260,23 +211,10 @@ class MotionEkf:
         y = z - hx
         if angle:
             y = wrap_angle(y)
-        Ph = self.P @ h
-        s = float(h @ Ph) + var
-        if not s > 0.0 or y * y > gate * gate * s:
-            return Outcome.REJECTED_OUTLIER
-        k = Ph / s
-        if only is None:
-            self.x += k * y
-            self.P -= k[:, None] * Ph[None, :]          # optimal gain: P - k (P h)^T
-        else:
-            k = k * only
-            self.x += k * y
-            # Joseph form for one row, valid for any gain k:
-            # (I - k h) P (I - k h)^T + k var k^T = P - k Ph^T - Ph k^T + k k^T (h P h + var)
-            kh_p = k[:, None] * Ph[None, :]
-            self.P = self.P - kh_p - kh_p.T + (k[:, None] * k[None, :]) * s
-        self.x[_YAW] = wrap_angle(self.x[_YAW])
-        return Outcome.ACCEPTED
+        masked = only is not None
+        accepted = kernels.update_scalar(self.x, self.P, float(y), h, float(var), float(gate),
+                                         masked, only if masked else _NO_MASK)
+        return Outcome.ACCEPTED if accepted else Outcome.REJECTED_OUTLIER
 
     def set_pose(self, x_m: float, y_m: float, yaw_rad: float, sigma_pos_m: float,
                  sigma_yaw_rad: float) -> None:

@@ -35,6 +35,12 @@ from dukw_estimation.settings import SENSORS, EkfSettings
 from dukw_estimation.surface import SurfaceObserver
 
 
+#: (port, starboard) before any track status
+_NO_PAIR = (math.nan, math.nan)
+# plain ints for the hot paths (indexing numpy with IntEnum members is slower)
+_YAW, _S, _ETA, _SOIL = int(Idx.YAW), int(Idx.S), int(Idx.ETA), int(Idx.SOIL)
+
+
 class Estimator:
     """Everything ekf_node computes, without ROS."""
 
@@ -48,6 +54,8 @@ class Estimator:
         self.stance = StanceDetector(stance_settings(settings))
         self.counters: dict[str, dict[Outcome, int]] = {s: defaultdict(int) for s in SENSORS}
         self.rates = {s: RateCounter() for s in SENSORS}
+        #: sensor -> fused (the settings are frozen: looked up once)
+        self._enabled = {s: settings.sensor_enabled(s) for s in SENSORS}
         self.reset()
 
     # ------------------------------------------------------------------ state
@@ -128,15 +136,17 @@ class Estimator:
     def _admit(self, sensor: str, t_s: float, values: tuple[float, ...]) -> Outcome | None:
         """Common checks; returns a rejection outcome, or None when the sample may be used
         (the filter then predicted to its time)."""
-        if not self.settings.sensor_enabled(sensor):
+        if not self._enabled[sensor]:
             return self._count(sensor, Outcome.IGNORED)
-        if not all(math.isfinite(v) for v in (t_s, *values)):
+        if not (math.isfinite(t_s) and all(map(math.isfinite, values))):
             return self._count(sensor, Outcome.REJECTED_NAN)
-        too_old = self.t_s is not None and t_s < self.t_s - self.settings.max_lag_s
-        if t_s <= self.motion_filter.last_t[sensor] or too_old:
+        motion = self.motion_filter
+        now_s = motion.t_s
+        too_old = now_s is not None and t_s < now_s - self.settings.max_lag_s
+        if t_s <= motion.last_t[sensor] or too_old:
             return self._count(sensor, Outcome.REJECTED_OUT_OF_ORDER)
-        self.motion_filter.predict_to(t_s, self.contact.fraction)
-        self.motion_filter.last_t[sensor] = t_s
+        motion.predict_to(t_s, self.contact.fraction)
+        motion.last_t[sensor] = t_s
         self.rates[sensor].tick(t_s)
         return None
 
@@ -305,44 +315,49 @@ class Estimator:
 
         A pure query: the afloat / sand decision is the one the last sample (or
         ``advance``) made; the volume and weight follow the present state."""
-        x = self.ekf.x
-        contact, tracks = self.contact, self.motion_filter.tracks
-        body = self.vehicle.body
+        x = self.motion_filter.ekf.x
+        contact, motion = self.contact, self.motion_filter
+        tracks = motion.tracks
         h2, grounded = contact.submersion(x)
         afloat = contact.afloat
         if afloat:
-            heave = contact.heave_accel_mps2(self.motion_filter.imu, self.motion_filter.accel_base)
-            volume = contact.afloat_volume_m3(heave, self.motion_filter.fresh_now('imu'))
+            heave = contact.heave_accel_mps2(motion.imu, motion.accel_base)
+            volume = contact.afloat_volume_m3(heave, motion.fresh_now('imu'))
         else:
-            volume = min(grounded, body.displaced_volume_m3)   # on the sand: it does not float
+            volume = min(grounded, contact.displaced_m3)   # on the sand: it does not float
         weight = contact.weight_n(grounded, afloat)
-        slips, predicted = self._slips_and_forces(weight)
-        return TractionEstimate(self.t_s or 0.0, slips[0], slips[1], volume, weight,
-                                contact.fraction_of(weight), float(x[Idx.S]), h2,
+        # the surface states as floats (the same values; numpy scalars cost more per use)
+        yaw, waterline, eta, soil = (x.item(_YAW), x.item(_S), x.item(_ETA), x.item(_SOIL))
+        slips, predicted = self._slips_and_forces(weight, waterline, eta, soil, yaw)
+        return TractionEstimate(motion.t_s or 0.0, slips[0], slips[1], volume, weight,
+                                contact.fraction_of(weight), waterline, h2,
                                 contact.slope_rad, predicted[0], predicted[1],
                                 contact.measured_soil_force_n(tracks, 0),
                                 contact.measured_soil_force_n(tracks, 1),
-                                afloat, float(x[Idx.ETA]))
+                                afloat, eta)
 
-    def _slips_and_forces(self, weight_n: float) -> tuple[list[float], list[float]]:
+    def _slips_and_forces(self, weight_n: float, waterline_m: float, eta_m: float,
+                          soil_scale: float, yaw_rad: float
+                          ) -> tuple[tuple[float, float], tuple[float, float]]:
         """Slip per track and the Wong force of ``weight_n`` at it (NaN before a status), at
-        the last status's time: its belt speeds against the ground speeds then."""
-        slips = [math.nan, math.nan]
-        predicted = [math.nan, math.nan]
+        the last status's time: its belt speeds against the ground speeds then; the surface
+        and the soil's strength factor are the filter's now."""
         tracks, ground = self.motion_filter.tracks, self.status_ground_mps
         if tracks is None or ground is None:
-            return slips, predicted
+            return _NO_PAIR, _NO_PAIR
         stopped = self.settings.slip_stopped_track_mps
-        speeds = [0.0 if abs(v) < stopped else v
-                  for v in (tracks.port.speed_mps, tracks.stbd.speed_mps)]
-        x = self.ekf.x
-        saturation = self.contact.saturation(
-            x[Idx.S], x[Idx.ETA], math.cos(x[Idx.YAW] - self.settings.seaward_yaw_rad))
-        for k in range(2):
-            slips[k] = traction.slip(speeds[k], ground[k])
-            predicted[k] = x[Idx.SOIL] * self.contact.track_force_n(
-                speeds[k], ground[k], 0.5 * weight_n, saturation)
-        return slips, predicted
+        port, stbd = tracks.port.speed_mps, tracks.stbd.speed_mps
+        port = 0.0 if abs(port) < stopped else float(port)
+        stbd = 0.0 if abs(stbd) < stopped else float(stbd)
+        contact = self.contact
+        saturation = contact.saturation(
+            waterline_m, eta_m, math.cos(yaw_rad - self.settings.seaward_yaw_rad))
+        ground_port, ground_stbd = float(ground[0]), float(ground[1])
+        half_weight = 0.5 * weight_n
+        return ((traction.slip_f(port, ground_port), traction.slip_f(stbd, ground_stbd)),
+                (soil_scale * contact.track_force_n(port, ground_port, half_weight, saturation),
+                 soil_scale * contact.track_force_n(stbd, ground_stbd, half_weight,
+                                                    saturation)))
 
     def health(self, now_s: float) -> list[Health]:
         """One Health per sensor (stale -> WARN, rejections counted) and one for the filter."""

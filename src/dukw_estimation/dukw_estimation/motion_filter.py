@@ -334,7 +334,7 @@ class MotionFilter:
         twist_cov = _TWIST_COV_BASE.copy()
         for a, b, i, j in _TWIST_COPY:
             twist_cov[a, b] = P[i, j]
-        z = -x[_S] * math.sin(slope_rad)
-        return OdometryEstimate(self.t_s or 0.0, float(x[_X]), float(x[_Y]), z, roll,
-                                pitch, float(x[_YAW]), float(x[_U]), float(x[_V]),
-                                float(x[_R]), pose_cov, twist_cov)
+        x_m, y_m, yaw, u, v, r, _, s = x[:_S + 1].tolist()     # floats: the same values
+        z = -s * math.sin(slope_rad)
+        return OdometryEstimate(self.t_s or 0.0, x_m, y_m, z, roll, pitch, yaw, u, v, r,
+                                pose_cov, twist_cov)

@@ -9,6 +9,7 @@ two agree (tested). Vectorised over arrays of h2.
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -95,12 +96,15 @@ def segment_area_integral_m3_per_m(depth_m: float, radius_m: float) -> float:
     r = radius_m
     d = max(depth_m, 0.0)
     full = 2.0 * r
-
-    def antiderivative(v: float) -> float:        # of A in v = r - u, A(v) = r^2 acos(v/r)
-        root = math.sqrt(max(r * r - v * v, 0.0))   # - v sqrt(r^2 - v^2)
-        return r * r * (v * math.acos(max(-1.0, min(1.0, v / r))) - root) + root ** 3 / 3.0
     inside = min(d, full)
-    return -antiderivative(r - inside) + math.pi * r * r * max(d - full, 0.0)
+    return -_segment_antiderivative(r - inside, r) + math.pi * r * r * max(d - full, 0.0)
+
+
+def _segment_antiderivative(v: float, r: float) -> float:
+    """Antiderivative of the segment area in v = r - u,
+    A(v) = r^2 acos(v/r) - v sqrt(r^2 - v^2)."""
+    root = math.sqrt(max(r * r - v * v, 0.0))
+    return r * r * (v * math.acos(max(-1.0, min(1.0, v / r))) - root) + root ** 3 / 3.0
 
 
 def cylinder_float_depth_m(displaced_volume_m3: float, radius_m: float,
@@ -155,6 +159,16 @@ class HullSection:
             _operand(0.0), _operand(r), _operand(r * r), _operand(self.float_depth_m),
             _operand(min(self.float_depth_m, 2.0 * r)), _operand(self.strut_width_m),
             _operand(self.top_depth_m)))
+
+    @functools.cached_property
+    def _float_area_m2(self) -> float:
+        """The section at the float line, m^2 (``area_integral_m3_per_m``'s constant)."""
+        return float(segment_area_m2(self.float_depth_m, self.radius_m))
+
+    @functools.cached_property
+    def _top_area_m2(self) -> float:
+        """The section with the deck awash, m^2 (``area_integral_m3_per_m``'s constant)."""
+        return float(self.area_m2(self.top_depth_m))
 
     @classmethod
     def of_hulls(cls, displaced_volume_m3: float, radius_m: float, length_m: float,
@@ -236,9 +250,9 @@ class HullSection:
         f = self.float_depth_m
         above = max(depth_m - f, 0.0)
         return segment_area_integral_m3_per_m(min(depth_m, f), self.radius_m) \
-            + float(segment_area_m2(f, self.radius_m)) * above \
+            + self._float_area_m2 * above \
             + 0.5 * self.strut_width_m * above * above \
-            + (float(self.area_m2(self.top_depth_m)) * over_deck if over_deck > 0.0 else 0.0)
+            + (self._top_area_m2 * over_deck if over_deck > 0.0 else 0.0)
 
     def line_volume_m3(self, depth0_m: float, gradient: float, bow_x_m: float,
                        stern_x_m: float) -> float:
@@ -280,9 +294,16 @@ def submerged_length_m(waterline_distance_m: float, slope_rad: float, hull_clear
     ``heading_cos`` is cos(yaw - seaward direction): 1 bow to the sea, -1 stern to the sea.
     The result is clipped to [0, bow - stern].
     """
-    depth0, gradient = _bottom_depth_line(waterline_distance_m, slope_rad, hull_clearance_m,
-                                          surface_m, heading_cos)
+    depth0, gradient = bottom_depth_line(waterline_distance_m, slope_rad, hull_clearance_m,
+                                         surface_m, heading_cos)
+    return submerged_length_of_line_m(depth0, gradient, bow_x_m, stern_x_m)
+
+
+def submerged_length_of_line_m(depth0_m: float, gradient: float, bow_x_m: float,
+                               stern_x_m: float) -> float:
+    """``submerged_length_m`` of the hull bottom line ``bottom_depth_line`` gave, m."""
     length = bow_x_m - stern_x_m
+    depth0 = depth0_m
     if abs(gradient) < 1e-9:
         return length if depth0 > 0.0 else 0.0
     deep_x = bow_x_m if gradient > 0.0 else stern_x_m
@@ -290,7 +311,7 @@ def submerged_length_m(waterline_distance_m: float, slope_rad: float, hull_clear
     return float(min(max(deep / abs(gradient), 0.0), length))
 
 
-def _bottom_depth_line(waterline_distance_m: float, slope_rad: float, hull_clearance_m: float,
+def bottom_depth_line(waterline_distance_m: float, slope_rad: float, hull_clearance_m: float,
                        surface_m: float, heading_cos: float) -> tuple[float, float]:
     """Water depth over the hull bottom (normal to the hull) at base_link x = 0, and its
     gradient per metre of body x, for a vehicle lying on the slope."""
@@ -312,11 +333,17 @@ def grounded_volume_m3(waterline_distance_m: float, slope_rad: float, hull_clear
     capped at the displacement: compare with ``afloat_volume_m3`` to know whether the
     vehicle floats.
     """
-    depth0, gradient = _bottom_depth_line(waterline_distance_m, slope_rad, hull_clearance_m,
-                                          surface_m, heading_cos)
+    depth0, gradient = bottom_depth_line(waterline_distance_m, slope_rad, hull_clearance_m,
+                                         surface_m, heading_cos)
     if section is None:
         section = HullSection(radius_m, 2.0 * radius_m, 0.0)
-    return 2.0 * section.line_volume_m3(depth0, gradient, bow_x_m, stern_x_m)
+    return grounded_volume_of_line_m3(depth0, gradient, bow_x_m, stern_x_m, section)
+
+
+def grounded_volume_of_line_m3(depth0_m: float, gradient: float, bow_x_m: float,
+                               stern_x_m: float, section: HullSection) -> float:
+    """``grounded_volume_m3`` of the hull bottom line ``bottom_depth_line`` gave, m^3."""
+    return 2.0 * section.line_volume_m3(depth0_m, gradient, bow_x_m, stern_x_m)
 
 
 def afloat_dynamic_volume_m3(displacement_n: float, heave_mass_kg_: float,
