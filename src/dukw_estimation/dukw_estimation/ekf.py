@@ -14,50 +14,26 @@ the IMU's attitude error (0.2 deg x g = 0.034 m/s^2 for ~10 s), which the veloci
 otherwise integrate into a ground-speed bias of a few cm/s (issue 18: the slip at low belt
 speeds).
 
-Predict and update are written with numpy directly rather than through filterpy's
+Predict and update are the compiled kernels of ``ekf_kernels`` rather than filterpy's
 generic ``ExtendedKalmanFilter``: its update cannot gate an innovation before applying it
-and copies the state several times per call; this keeps one predict + update well under
-100 us (benchmarks/bench_ekf.py). The track-force smoother does use filterpy.
+and copies the state several times per call; a predict + scalar update is ~3 us
+(benchmarks/bench_ekf.py). The track-force smoother does use filterpy.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from enum import Enum, IntEnum
+from enum import Enum
 
 import numpy as np
 
 from dukw_common.geometry import wrap_angle
 from dukw_estimation import ekf_kernels as kernels
+from dukw_estimation.ekf_states import N_STATES, Idx
 
 
-class Idx(IntEnum):
-    """Positions in the state vector."""
-
-    X = 0
-    Y = 1
-    YAW = 2
-    U = 3
-    V = 4
-    R = 5
-    BIAS = 6
-    S = 7
-    ETA = 8
-    ETA_RATE = 9
-    GPS_BIAS_E = 10
-    GPS_BIAS_N = 11
-    SOIL = 12
-    ACCEL_BIAS_X = 13
-    ACCEL_BIAS_Y = 14
-
-
-N_STATES = len(Idx)
-# plain ints for the hot paths (indexing numpy with IntEnum members is slower)
-_X, _Y, _YAW, _U, _V, _R = (int(Idx.X), int(Idx.Y), int(Idx.YAW), int(Idx.U), int(Idx.V),
-                            int(Idx.R))
-_S, _ETA, _ETA_RATE, _GBE, _GBN = (int(Idx.S), int(Idx.ETA), int(Idx.ETA_RATE),
-                                   int(Idx.GPS_BIAS_E), int(Idx.GPS_BIAS_N))
-_ABX, _ABY = int(Idx.ACCEL_BIAS_X), int(Idx.ACCEL_BIAS_Y)
+# plain int for the hot path (indexing numpy with IntEnum members is slower)
+_YAW = int(Idx.YAW)
 #: The states the water-contact and track-force measurements may correct (the soil through
 #: its correlation with the surface: both explain one force).
 SURFACE_STATES = np.array([1.0 if i in (Idx.S, Idx.ETA, Idx.ETA_RATE, Idx.SOIL) else 0.0

@@ -17,10 +17,15 @@ import math
 import numpy as np
 from numba import njit
 
-# state indices (ekf.Idx; plain ints: numba folds them in as constants)
-_X, _Y, _YAW, _U, _V, _R = 0, 1, 2, 3, 4, 5
-_S, _ETA, _ETA_RATE, _GBE, _GBN = 7, 8, 9, 10, 11
-_ABX, _ABY = 13, 14
+from dukw_estimation.ekf_states import Idx
+
+# state indices as plain ints: numba folds them in as constants when it compiles (its
+# cache follows this file: a change of ekf_states.Idx needs the cache rebuilt, make setup)
+_X, _Y, _YAW, _U, _V, _R = (int(Idx.X), int(Idx.Y), int(Idx.YAW), int(Idx.U), int(Idx.V),
+                            int(Idx.R))
+_S, _ETA, _ETA_RATE, _GBE, _GBN = (int(Idx.S), int(Idx.ETA), int(Idx.ETA_RATE),
+                                   int(Idx.GPS_BIAS_E), int(Idx.GPS_BIAS_N))
+_ABX, _ABY = int(Idx.ACCEL_BIAS_X), int(Idx.ACCEL_BIAS_Y)
 #: ``predict``'s input modes: held, the IMU's accelerations, the drive model's target
 HOLD, ACCEL, DRIVE = 0, 1, 2
 
@@ -194,7 +199,7 @@ def update_rows_2d(x: np.ndarray, P: np.ndarray, y0: float, y1: float, H: np.nda
     return True
 
 
-def warm(n_states: int = 15) -> None:
+def warm(n_states: int = len(Idx)) -> None:
     """Compile (or load) every kernel for the argument types the filter passes, so that the
     first sample of a process does not (``make setup`` runs this once per build: the cache
     beside the module then serves every later process)."""
