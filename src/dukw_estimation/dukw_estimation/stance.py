@@ -100,13 +100,7 @@ class StanceDetector:
             self.reset()
             if not finite:
                 return False
-        ax_var, ay_var, az_var = s.accel_var_m2ps4
-        sigmas = (_sigma(ax_var, st.accel_sigma_mps2), _sigma(ay_var, st.accel_sigma_mps2),
-                  _sigma(az_var, st.accel_sigma_mps2),
-                  _sigma(s.roll_rate_var_rps2, st.gyro_sigma_rps),
-                  _sigma(s.pitch_rate_var_rps2, st.gyro_sigma_rps),
-                  _sigma(s.yaw_rate_var_rps2, st.gyro_sigma_rps))
-        z = tuple(v / sigma for v, sigma in zip(values, sigmas, strict=True))
+        z = tuple(v / sigma for v, sigma in zip(values, self._sigmas(s), strict=True))
         if math.isnan(self._since_t):
             self._since_t = s.t_s
         self._last_t = s.t_s
@@ -134,6 +128,22 @@ class StanceDetector:
             self.statistic = self.mean_accel_mps2 = self.mean_rate_rps = math.nan
             self.still = False
             return False
+        return self._decide(n)
+
+    def _sigmas(self, s: ImuSample) -> tuple[float, ...]:
+        """The six channels' noise: the sample's own variances, else the settings'."""
+        st = self.settings
+        ax_var, ay_var, az_var = s.accel_var_m2ps4
+        return (_sigma(ax_var, st.accel_sigma_mps2), _sigma(ay_var, st.accel_sigma_mps2),
+                _sigma(az_var, st.accel_sigma_mps2),
+                _sigma(s.roll_rate_var_rps2, st.gyro_sigma_rps),
+                _sigma(s.pitch_rate_var_rps2, st.gyro_sigma_rps),
+                _sigma(s.yaw_rate_var_rps2, st.gyro_sigma_rps))
+
+    def _decide(self, n: int) -> bool:
+        """The window's statistic and means from the running sums of its ``n`` samples, and
+        whether all three are under their thresholds."""
+        st = self.settings
         total, total_sq = self._sum, self._sum_sq
         deviation = sum(max(total_sq[i] - total[i] * total[i] / n, 0.0)
                         for i in range(_CHANNELS))
