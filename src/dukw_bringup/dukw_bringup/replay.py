@@ -23,9 +23,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterable, Sequence
 
+from dukw_bringup.bag_fields import read_fields
 from dukw_bringup.bag_io import (BagError, BagReader, deserialize, read_messages, topic_key,
                                  typestore)
 from dukw_bringup.replay_adapters import ADAPTERS, CoreAdapter
+from rosbags.typesys.store import Typestore
 
 
 @dataclass
@@ -175,9 +177,12 @@ def replay(bag: str | Path, adapters: Sequence[CoreAdapter]) -> ReplayResult:
     return result
 
 
+#: messages read, decoded and fed per batch (a long bag is never held whole)
+BATCH_MESSAGES = 20_000
+
+
 def _replay(reader: BagReader, bag: Path, adapters: Sequence[CoreAdapter],
             result: ReplayResult) -> None:
-    store = typestore()
     outputs = set().union(*(a.outputs for a in adapters))
     firsts = _first_output_ns(reader, outputs)
     for adapter in adapters:
@@ -186,31 +191,8 @@ def _replay(reader: BagReader, bag: Path, adapters: Sequence[CoreAdapter],
                            f'{adapter.name} replay on')
     drivers = [_Driver(a, min(firsts[o] for o in a.outputs if o in firsts)) for a in adapters]
     wanted = outputs.union(*(a.inputs for a in adapters))
-    routes: dict[str, tuple[str, list[tuple[_Driver, bool, bool]]]] = {}
-    decode = store.deserialize_cdr       # (bag_io.deserialize without its per-call lookup)
-    last_ns = None
     start, start_cpu = time.perf_counter(), time.thread_time()
-    for topic, msgtype, t_ns, raw in reader.messages(wanted):
-        route = routes.get(topic)
-        if route is None:       # each topic's key and the drivers that use it
-            key = topic_key(topic)
-            route = routes[topic] = (key, [
-                (d, key in d.adapter.inputs, key in d.adapter.outputs) for d in drivers
-                if key in d.adapter.inputs or key in d.adapter.outputs])
-        key, steps = route
-        msg = decode(raw, msgtype)
-        result.messages += 1
-        last_ns = t_ns
-        for driver, feeds, compares in steps:
-            # a driver's ticks run when its next message comes (the cores are independent:
-            # the same ticks, in the same order with its own messages, as at every message)
-            if driver.next_tick_ns is not None and driver.next_tick_ns < t_ns:
-                driver.run_ticks_until(t_ns, inclusive=False)
-            if feeds:
-                driver.feed(key, t_ns, msg)
-            if compares:
-                driver.run_ticks_until(t_ns, inclusive=True)
-                driver.compare(key, t_ns, msg)
+    result.messages, last_ns = _feed_bag(reader, wanted, drivers)
     if last_ns is not None:     # every driver ticks up to the bag's last message
         for driver in drivers:
             driver.run_ticks_until(last_ns, inclusive=False)
@@ -220,6 +202,74 @@ def _replay(reader: BagReader, bag: Path, adapters: Sequence[CoreAdapter],
         driver.finish()
         result.rows[driver.adapter.name] = driver.rows
         result.deviations[driver.adapter.name] = driver.deviations
+
+
+def _feed_bag(reader: BagReader, wanted: set[str], drivers: Sequence[_Driver]
+              ) -> tuple[int, int | None]:
+    """Every wanted message, batch by batch; returns (messages, the last one's time ns)."""
+    count, last_ns, batch = 0, None, []
+    for message in reader.messages(wanted):
+        batch.append(message)
+        if len(batch) == BATCH_MESSAGES:
+            count, last_ns = count + len(batch), _feed_batch(batch, drivers)
+            batch = []
+    if batch:
+        count, last_ns = count + len(batch), _feed_batch(batch, drivers)
+    return count, last_ns
+
+
+def _routes(batch: Sequence[tuple[str, str, int, bytes]], drivers: Sequence[_Driver]
+            ) -> dict[str, tuple[str, list[tuple[_Driver, bool, bool, Callable[[], Any]]]]]:
+    """Per topic of ``batch``: its key and, for each driver that uses it, (driver, feeds,
+    compares, the next of its messages as the driver reads them). A driver that names the
+    fields it reads (``CoreAdapter.fields``) gets them as a tuple, decoded for the whole
+    batch at once (bag_fields); one that does not gets rosbags' message object."""
+    store = typestore()
+    raws: dict[str, list[bytes]] = {}
+    msgtypes: dict[str, str] = {}
+    for topic, msgtype, _, raw in batch:
+        raws.setdefault(topic, []).append(raw)
+        msgtypes.setdefault(topic, msgtype)
+    routes = {}
+    for topic, topic_raws in raws.items():
+        key = topic_key(topic)
+        users = [d for d in drivers if key in d.adapter.inputs or key in d.adapter.outputs]
+        decoded = {paths: _decoded(store, msgtypes[topic], topic_raws, paths)
+                   for paths in {d.adapter.fields.get(key) for d in users}}
+        routes[topic] = (key, [(d, key in d.adapter.inputs, key in d.adapter.outputs,
+                                iter(decoded[d.adapter.fields.get(key)]).__next__)
+                               for d in users])
+    return routes
+
+
+def _decoded(store: Typestore, msgtype: str, raws: Sequence[bytes],
+             paths: tuple[str, ...] | None) -> list[Any]:
+    """Messages as a driver reads them: tuples of the fields ``paths``, or (None) rosbags'
+    message objects."""
+    if paths:
+        return read_fields(store, msgtype, raws, paths)
+    return [store.deserialize_cdr(raw, msgtype) for raw in raws]
+
+
+def _feed_batch(batch: Sequence[tuple[str, str, int, bytes]], drivers: Sequence[_Driver]
+                ) -> int:
+    """Feed ``batch``'s messages, in order, to the drivers that use them; returns the last
+    message's time, ns."""
+    routes = _routes(batch, drivers)
+    for topic, _, t_ns, _ in batch:
+        key, steps = routes[topic]
+        for driver, feeds, compares, take in steps:
+            msg = take()
+            # a driver's ticks run when its next message comes (the cores are independent:
+            # the same ticks, in the same order with its own messages, as at every message)
+            if driver.next_tick_ns is not None and driver.next_tick_ns < t_ns:
+                driver.run_ticks_until(t_ns, inclusive=False)
+            if feeds:
+                driver.feed(key, t_ns, msg)
+            if compares:
+                driver.run_ticks_until(t_ns, inclusive=True)
+                driver.compare(key, t_ns, msg)
+    return batch[-1][2]
 
 
 def stream(bag: str | Path, decode: bool = False,
