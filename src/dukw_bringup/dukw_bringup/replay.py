@@ -19,9 +19,13 @@ import csv
 import math
 import sys
 import time
+from collections import defaultdict
 from dataclasses import dataclass, field
+from operator import itemgetter
 from pathlib import Path
 from typing import Any, Callable, Iterable, Sequence
+
+import numpy as np
 
 from dukw_bringup.bag_fields import read_fields
 from dukw_bringup.bag_io import (BagError, BagReader, deserialize, read_messages, topic_key,
@@ -93,8 +97,8 @@ class _Driver:
         self.latest: dict[str, float] | None = None
         self.rows: list[dict[str, float]] = []
         self.deviations: dict[str, Deviation] = {}
-        #: per compared topic: its quantities, exact matches not yet counted, their deviations
-        self._matched: dict[str, list[Any]] = {}
+        #: per compared topic: (time ns, recorded message, latest replayed row) not compared
+        self._pending: defaultdict[str, list[tuple[int, Any, Any]]] = defaultdict(list)
 
     def run_ticks_until(self, t_ns: int, inclusive: bool) -> None:
         if self.next_tick_ns is None:
@@ -115,44 +119,62 @@ class _Driver:
             self.rows.append({'t_s': t_s, **out})
 
     def compare(self, topic: str, t_ns: int, msg: Any) -> None:
-        recorded = self.adapter.recorded(topic, msg)
-        replayed = self.latest or {}
-        matched = self._matched.get(topic)
-        # every quantity as replayed, bit for bit (the usual case): only the counts move,
-        # added in ``finish`` (a dict items view compares in C: no loop here)
-        if matched is not None and matched[0] == recorded.keys() and \
-                recorded.items() <= replayed.items():
-            matched[1] += 1
-            return
-        self._compare(recorded, replayed, t_ns)
-        if matched is None:      # the first time: from now on the fast path can count them
-            self._matched[topic] = [recorded.keys(), 0, [self.deviations[q] for q in recorded]]
+        """Note a recorded output and the latest replayed one (``settle`` compares)."""
+        self._pending[topic].append((t_ns, msg, self.latest))
 
-    def _compare(self, recorded: dict[str, float], replayed: dict[str, float],
-                 t_ns: int) -> None:
-        deviations, angles, nan = self.deviations, self.adapter.angle_quantities, math.nan
-        for quantity, value in recorded.items():
-            dev = deviations.get(quantity)
-            if dev is None:     # (not setdefault: it would build a Deviation every time)
-                dev = deviations[quantity] = Deviation(self.adapter.name, quantity)
-            mine = replayed.get(quantity, nan)
-            diff = abs(mine - value)
-            if diff != diff:                  # NaN: both NaN is a match, one NaN is not
-                if mine != mine and value != value:
-                    diff = 0.0
-            elif diff > math.pi and quantity in angles:
-                diff = abs(math.remainder(mine - value, math.tau))
-            compared = dev.compared = dev.compared + 1
-            worst = dev.max_abs
-            if compared == 1 or diff > worst or (diff != diff and worst == worst):
-                dev.max_abs, dev.at_s, dev.replayed, dev.recorded = diff, t_ns * 1e-9, mine, value
+    def settle(self) -> None:
+        """Compare the outputs noted since the last call, each quantity over all of them at
+        once (the adapter's ``recorded_columns``, numpy for the differences)."""
+        angles = self.adapter.angle_quantities
+        for topic, pending in self._pending.items():
+            times_ns, msgs, replayed = zip(*pending, strict=True)
+            recorded = self.adapter.recorded_columns(topic, msgs)
+            mine = _replayed_columns(replayed, tuple(recorded))
+            for quantity, theirs in recorded.items():
+                dev = self.deviations.get(quantity)
+                if dev is None:
+                    dev = self.deviations[quantity] = Deviation(self.adapter.name, quantity)
+                _fold(dev, times_ns, mine[quantity], theirs, quantity in angles)
+        self._pending.clear()
 
     def finish(self) -> None:
-        """Add the comparisons the fast path only counted to their deviations."""
-        for _, count, devs in self._matched.values():
-            for dev in devs:
-                dev.compared += count
-        self._matched.clear()
+        """Compare what is still noted."""
+        self.settle()
+
+
+def _replayed_columns(rows: Sequence[dict[str, float] | None], quantities: tuple[str, ...]
+                      ) -> dict[str, Sequence[float]]:
+    """Per quantity, its value in each replayed row (NaN where a row lacks it or is None)."""
+    try:
+        get = itemgetter(*quantities)
+        values = [get(row) for row in rows]        # (one C call per row: the usual case)
+        if len(quantities) == 1:
+            values = [(v,) for v in values]
+    except (KeyError, TypeError):
+        values = [tuple(math.nan if row is None else row.get(q, math.nan) for q in quantities)
+                  for row in rows]
+    return dict(zip(quantities, zip(*values, strict=True), strict=True))
+
+
+def _fold(dev: Deviation, times_ns: Sequence[int], mine: Sequence[float],
+          theirs: Sequence[float], angle: bool) -> None:
+    """Fold comparisons into ``dev`` as one by one in order would: |replayed - recorded|
+    (both NaN: 0, one NaN: NaN; an angle modulo 2 pi), the first worst kept, NaN worst of
+    all."""
+    replayed, recorded = np.asarray(mine, dtype=float), np.asarray(theirs, dtype=float)
+    diff = np.abs(replayed - recorded)
+    diff[np.isnan(replayed) & np.isnan(recorded)] = 0.0
+    if angle:
+        for k in np.flatnonzero(diff > math.pi):
+            diff[k] = abs(math.remainder(float(replayed[k]) - float(recorded[k]), math.tau))
+    nan = np.isnan(diff)
+    k = int(np.argmax(nan)) if nan.any() else int(np.argmax(diff))
+    worst = float(diff[k])
+    first = dev.compared == 0
+    dev.compared += len(diff)
+    if first or worst > dev.max_abs or (worst != worst and dev.max_abs == dev.max_abs):
+        dev.max_abs, dev.at_s = worst, times_ns[k] * 1e-9
+        dev.replayed, dev.recorded = float(replayed[k]), float(recorded[k])
 
 
 def _first_output_ns(bag: BagReader, topics: set[str]) -> dict[str, int]:
@@ -269,6 +291,8 @@ def _feed_batch(batch: Sequence[tuple[str, str, int, bytes]], drivers: Sequence[
             if compares:
                 driver.run_ticks_until(t_ns, inclusive=True)
                 driver.compare(key, t_ns, msg)
+    for driver in drivers:
+        driver.settle()
     return batch[-1][2]
 
 

@@ -16,7 +16,7 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from operator import attrgetter
 from types import MappingProxyType
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Mapping, Sequence
 
 from dukw_common.cmd_vel import read_cmd_vel
 from dukw_common.config import node_params
@@ -60,10 +60,21 @@ class CoreAdapter(ABC):
         """The node's timer at ``t_s``: step the core and return its output as named
         numbers, or None when the node skips this tick (publishes nothing)."""
 
-    @abstractmethod
     def recorded(self, topic: str, msg: Any) -> dict[str, float]:
         """The same named numbers from a recorded output message on ``topic`` (the tuple of
-        its ``fields``, or the message)."""
+        its ``fields``, or the message). Implement this or ``recorded_columns``."""
+        raise NotImplementedError(f'{self.name}: neither recorded nor recorded_columns')
+
+    def recorded_columns(self, topic: str, msgs: Sequence[Any]) -> dict[str, Sequence[float]]:
+        """Per quantity, its values in the recorded output messages ``msgs`` on ``topic``
+        (the replay compares many at once); by default ``recorded`` of each, which must name
+        the same quantities every time."""
+        rows = [self.recorded(topic, msg) for msg in msgs]
+        names = rows[0].keys()
+        if any(row.keys() != names for row in rows):
+            raise ValueError(f'{self.name}: the recorded {topic} quantities differ from one '
+                             'message to the next')
+        return {name: [row[name] for row in rows] for name in names}
 
 
 def _side_row(prefix: str, port: float, stbd: float) -> dict[str, float]:
@@ -195,9 +206,10 @@ class DriveControllerAdapter(CoreAdapter):
     #: recorded output topic -> its row names (made once, not per message)
     _ROW_NAMES = {topic: tuple(_side_row(topic.split('/')[0], 0.0, 0.0)) for topic in outputs}
 
-    def recorded(self, topic, msg):
+    def recorded_columns(self, topic, msgs):
         port_name, stbd_name = self._ROW_NAMES[topic]
-        return {port_name: float(msg[0]), stbd_name: float(msg[1])}
+        port_pct, stbd_pct = zip(*msgs, strict=True)
+        return {port_name: port_pct, stbd_name: stbd_pct}
 
 
 #: nav_msgs/Odometry's fields the EKF's rows compare
@@ -251,16 +263,14 @@ class EkfAdapter(CoreAdapter):
 
     _traction_values = staticmethod(attrgetter(*TRACTION_FIELDS))
 
-    @staticmethod
-    def _odometry_row(x_m, y_m, qx, qy, qz, qw, surge_mps, yaw_rate_rps) -> dict[str, float]:
-        return {'odom.x_m': float(x_m), 'odom.y_m': float(y_m),
-                'odom.yaw_rad': float(euler_from_quaternion(qx, qy, qz, qw)[2]),
-                'odom.surge_mps': float(surge_mps), 'odom.yaw_rate_rps': float(yaw_rate_rps)}
-
-    def recorded(self, topic, msg):
-        if topic == 'odometry/filtered':
-            return self._odometry_row(*msg)
-        return dict(zip(self._TRACTION_KEYS, map(float, msg), strict=True))
+    def recorded_columns(self, topic, msgs):
+        columns = tuple(zip(*msgs, strict=True))
+        if topic != 'odometry/filtered':
+            return dict(zip(self._TRACTION_KEYS, columns, strict=True))
+        x_m, y_m, qx, qy, qz, qw, surge_mps, yaw_rate_rps = columns
+        yaw_rad = [euler_from_quaternion(*q)[2] for q in zip(qx, qy, qz, qw, strict=True)]
+        return {'odom.x_m': x_m, 'odom.y_m': y_m, 'odom.yaw_rad': yaw_rad,
+                'odom.surge_mps': surge_mps, 'odom.yaw_rate_rps': yaw_rate_rps}
 
 
 #: adapter name -> factory (config path -> adapter)
