@@ -16,7 +16,7 @@ from sensor_msgs.msg import NavSatStatus
 from dukw_common.geometry import euler_from_quaternion, quaternion_from_euler
 from dukw_common.node_tools import stamp_s_or, stamp_to_s
 from dukw_common.readings import (DepthReading, DriveStatus, GpsFix, GpsVelocity, ImuSample,
-                                  MotorSide, WaterContact)
+                                  MotorSide, WaterContact, positional_builder)
 from dukw_estimation.samples import OdometryEstimate, TractionEstimate
 
 #: dukw_msgs/DrivetrainStatus.drive (DRIVE_TRACKS, DRIVE_PROPELLERS) -> DriveStatus.drive
@@ -32,6 +32,10 @@ def _diag_var(cov) -> tuple[float, float, float]:
     """The three diagonal entries of a row-major 3x3 covariance (NaN where not given)."""
     return _var(cov[0]), _var(cov[4]), _var(cov[8])
 
+
+#: the readings built at every IMU sample and drive status (all fields, in order)
+_imu_sample = positional_builder(ImuSample)
+_motor_side_fields = positional_builder(MotorSide)
 
 #: the message fields each sample conversion reads, in the order its rule takes them: the
 #: node reads them from its messages (``SAMPLE_FROM_MSG``), the offline replay as columns
@@ -59,11 +63,10 @@ def imu_from_fields(t_s, qx, qy, qz, qw, att_cov, wx, wy, wz, rate_cov, ax, ay, 
     else:
         acc_var = _diag_var(acc_cov)
     rate_var = _diag_var(rate_cov)
-    return ImuSample(t_s, roll, pitch, yaw, wx, wy, wz, ax, ay, az,
-                     yaw_var_rad2=att_var[2], yaw_rate_var_rps2=rate_var[2],
-                     roll_var_rad2=att_var[0], pitch_var_rad2=att_var[1],
-                     roll_rate_var_rps2=rate_var[0], pitch_rate_var_rps2=rate_var[1],
-                     accel_var_m2ps4=acc_var)
+    # ImuSample's fields in order (variances: yaw, yaw rate, roll, pitch, roll rate, pitch
+    # rate, accelerations)
+    return _imu_sample(t_s, roll, pitch, yaw, wx, wy, wz, ax, ay, az, att_var[2], rate_var[2],
+                       att_var[0], att_var[1], rate_var[0], rate_var[1], acc_var)
 
 
 GPS_FIX_FIELDS = ('latitude', 'longitude', 'altitude', 'position_covariance',
@@ -117,8 +120,8 @@ DRIVE_STATUS_FIELDS = ('drive', 'connected', *(f'port.{n}' for n in MOTOR_SIDE_F
 
 def _motor_side(command_pct, current_a, speed_mps, force_n, voltage_v, temperature_c,
                 fault_flags, faults) -> MotorSide:
-    return MotorSide(command_pct, current_a, speed_mps, force_n, voltage_v, temperature_c,
-                     int(fault_flags), tuple(faults))
+    return _motor_side_fields(command_pct, current_a, speed_mps, force_n, voltage_v,
+                              temperature_c, int(fault_flags), tuple(faults))
 
 
 def drive_status_from_fields(t_s, drive, connected, *sides) -> DriveStatus:
