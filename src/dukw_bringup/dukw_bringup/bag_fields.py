@@ -145,7 +145,7 @@ def _columns(store: Typestore, msgtype: str, raws: Sequence[bytes],
     size = len(first)
     # the payload ends at the layout's end, up to 3 bytes of padding after it
     if not layout.pos + _ENCAPSULATION_BYTES <= size <= layout.pos + _ENCAPSULATION_BYTES + 3 \
-            or any(len(raw) != size for raw in raws):
+            or len(set(map(len, raws))) != 1:
         return None
     view = np.frombuffer(b''.join(raws), _dtype(layout, size))
     if (view['#cdr'] != _CDR_LE).any() or any(

@@ -22,6 +22,7 @@ import sys
 import time
 from collections import defaultdict
 from contextlib import contextmanager
+from itertools import islice
 from dataclasses import dataclass, field
 from operator import itemgetter
 from pathlib import Path
@@ -33,6 +34,7 @@ from dukw_bringup.bag_fields import read_fields
 from dukw_bringup.bag_io import (BagError, BagReader, deserialize, read_messages, topic_key,
                                  typestore)
 from dukw_bringup.replay_adapters import ADAPTERS, CoreAdapter
+from rosbags.interfaces import Connection
 from rosbags.typesys.store import Typestore
 
 
@@ -231,38 +233,38 @@ def _replay(reader: BagReader, bag: Path, adapters: Sequence[CoreAdapter],
 def _feed_bag(reader: BagReader, wanted: set[str], drivers: Sequence[_Driver]
               ) -> tuple[int, int | None]:
     """Every wanted message, batch by batch; returns (messages, the last one's time ns)."""
-    count, last_ns, batch = 0, None, []
-    for message in reader.messages(wanted):
-        batch.append(message)
-        if len(batch) == BATCH_MESSAGES:
-            count, last_ns = count + len(batch), _feed_batch(batch, drivers)
-            batch = []
-    if batch:
+    count, last_ns, records = 0, None, reader.records(wanted)
+    while batch := list(islice(records, BATCH_MESSAGES)):
         count, last_ns = count + len(batch), _feed_batch(batch, drivers)
     return count, last_ns
 
 
-def _routes(batch: Sequence[tuple[str, str, int, bytes]], drivers: Sequence[_Driver]
-            ) -> dict[str, tuple[str, list[tuple[_Driver, bool, bool, Callable[[], Any]]]]]:
-    """Per topic of ``batch``: its key and, for each driver that uses it, (driver, feeds,
-    compares, the next of its messages as the driver reads them). A driver that names the
-    fields it reads (``CoreAdapter.fields``) gets them as a tuple, decoded for the whole
-    batch at once (bag_fields); one that does not gets rosbags' message object."""
+def _routes(batch: Sequence[tuple[Connection, int, bytes]], drivers: Sequence[_Driver]
+            ) -> dict[int, tuple[str, list[tuple[_Driver, bool, bool, Callable[[], Any]]]]]:
+    """Per connection (topic) of ``batch``, by its id: the topic's key and, for each driver
+    that uses it, (driver, feeds, compares, the next of its messages as the driver reads
+    them). A driver that names the fields it reads (``CoreAdapter.fields``) gets them as a
+    tuple, decoded for the whole batch at once (bag_fields); one that does not gets
+    rosbags' message object."""
     store = typestore()
-    raws: dict[str, list[bytes]] = {}
-    msgtypes: dict[str, str] = {}
-    for topic, msgtype, _, raw in batch:
-        raws.setdefault(topic, []).append(raw)
-        msgtypes.setdefault(topic, msgtype)
+    raws: dict[int, list[bytes]] = {}
+    connections: dict[int, Connection] = {}
+    for conn, _, raw in batch:
+        topic_raws = raws.get(conn.id)
+        if topic_raws is None:
+            topic_raws = raws[conn.id] = []
+            connections[conn.id] = conn
+        topic_raws.append(raw)
     routes = {}
-    for topic, topic_raws in raws.items():
-        key = topic_key(topic)
+    for conn_id, topic_raws in raws.items():
+        conn = connections[conn_id]
+        key = topic_key(conn.topic)
         users = [d for d in drivers if key in d.adapter.inputs or key in d.adapter.outputs]
-        decoded = {paths: _decoded(store, msgtypes[topic], topic_raws, paths)
+        decoded = {paths: _decoded(store, conn.msgtype, topic_raws, paths)
                    for paths in {d.adapter.fields.get(key) for d in users}}
-        routes[topic] = (key, [(d, key in d.adapter.inputs, key in d.adapter.outputs,
-                                iter(decoded[d.adapter.fields.get(key)]).__next__)
-                               for d in users])
+        routes[conn_id] = (key, [(d, key in d.adapter.inputs, key in d.adapter.outputs,
+                                  iter(decoded[d.adapter.fields.get(key)]).__next__)
+                                 for d in users])
     return routes
 
 
@@ -275,7 +277,7 @@ def _decoded(store: Typestore, msgtype: str, raws: Sequence[bytes],
     return [store.deserialize_cdr(raw, msgtype) for raw in raws]
 
 
-def _feed_batch(batch: Sequence[tuple[str, str, int, bytes]], drivers: Sequence[_Driver]
+def _feed_batch(batch: Sequence[tuple[Connection, int, bytes]], drivers: Sequence[_Driver]
                 ) -> int:
     """Feed ``batch``'s messages, in order, to the drivers that use them; returns the last
     message's time, ns."""
@@ -298,11 +300,11 @@ def _no_cycle_collection() -> Iterator[None]:
             gc.enable()
 
 
-def _feed_batch_in_order(batch: Sequence[tuple[str, str, int, bytes]],
+def _feed_batch_in_order(batch: Sequence[tuple[Connection, int, bytes]],
                          drivers: Sequence[_Driver]) -> int:
     routes = _routes(batch, drivers)
-    for topic, _, t_ns, _ in batch:
-        key, steps = routes[topic]
+    for conn, t_ns, _ in batch:
+        key, steps = routes[conn.id]
         for driver, feeds, compares, take in steps:
             msg = take()
             # a driver's ticks run when its next message comes (the cores are independent:
@@ -316,7 +318,7 @@ def _feed_batch_in_order(batch: Sequence[tuple[str, str, int, bytes]],
                 driver.compare(key, t_ns, msg)
     for driver in drivers:
         driver.settle()
-    return batch[-1][2]
+    return batch[-1][1]
 
 
 def stream(bag: str | Path, decode: bool = False,
