@@ -11,11 +11,13 @@ from __future__ import annotations
 import argparse
 import tempfile
 import time
+from functools import partial
 from pathlib import Path
 
 from dukw_bringup import bag_io
+from dukw_bringup import replay as replay_module
 from dukw_bringup.replay import replay, stream
-from dukw_bringup.replay_adapters import ADAPTERS, EkfAdapter
+from dukw_bringup.replay_adapters import ADAPTERS, CoreAdapter, EkfAdapter
 from dukw_estimation import ros_convert
 from figures import report
 from profile_text import profile_to_text
@@ -114,6 +116,64 @@ def print_bound(bag: Path, messages: int, rate: float) -> None:
            imu[1] / max(imu[0], 1) * 1e6, 'us', target=100.0)
 
 
+class IdleCore(CoreAdapter):
+    """A core that does nothing, with ``real``'s topics, fields and timer: the replay's
+    reading, decoding and loop around it, without its work."""
+
+    def __init__(self, real: CoreAdapter) -> None:
+        self.name, self.inputs, self.outputs = real.name, real.inputs, real.outputs
+        self.rate_hz, self.fields = real.rate_hz, real.fields
+
+    def feed(self, topic, t_s, msg):
+        return None
+
+    def tick(self, t_s):
+        return None
+
+    def recorded_columns(self, topic, msgs):
+        return {}
+
+
+def replay_phases(bag: Path, adapters: list[CoreAdapter]) -> tuple[float, float, float]:
+    """One replay of ``bag`` (one batch) in its three steps, each on the thread's CPU clock:
+    reading the records, decoding them (every topic's fields as columns, the routes) and
+    feeding them through the cores (their steps, outputs and comparisons). Seconds. Drives
+    dukw_bringup.replay's own steps, as replay() does, apart."""
+    clock = time.thread_time
+    with bag_io.BagReader(bag) as reader:
+        drivers, wanted = replay_module._drivers(reader, bag, adapters)
+        start = clock()
+        batch = list(reader.records(wanted))
+        read = clock()
+        with replay_module._no_cycle_collection():
+            routes = replay_module._routes(batch, drivers)
+            decoded = clock()
+            replay_module._feed_batch_in_order(batch, drivers, routes)
+        return read - start, decoded - read, clock() - decoded
+
+
+def print_phases(bag: Path, repeat: int = 7) -> None:
+    """The phases of a replay through all cores, and each core's own feeding (the others
+    idle), best of ``repeat`` each."""
+    def best(make) -> list[float]:
+        runs = [replay_phases(bag, make()) for _ in range(repeat)]
+        return [min(run[k] for run in runs) * 1e3 for k in range(3)]
+    best(lambda: [f() for f in ADAPTERS.values()])                      # warm up
+    read, decode, feed = best(lambda: [f() for f in ADAPTERS.values()])
+    print(f'phases  : {bag.name:<16} all cores: read {read:.1f} ms, decode {decode:.1f} ms, '
+          f'feed {feed:.1f} ms (CPU clock, best of {repeat} each)')
+    idle = best(lambda: [IdleCore(f()) for f in ADAPTERS.values()])[2]
+    own = {name: best(partial(_alone, name))[2] - idle for name in ADAPTERS}
+    print(f"          feeding: the loop with idle cores {idle:.1f} ms; each core's own work "
+          '(its steps, conversions, rows, comparisons): '
+          + ', '.join(f'{name} {ms:.1f} ms' for name, ms in own.items()))
+
+
+def _alone(name: str) -> list[CoreAdapter]:
+    """The core ``name`` and the others idle."""
+    return [ADAPTERS[n]() if n == name else IdleCore(ADAPTERS[n]()) for n in ADAPTERS]
+
+
 PROFILE_HEADER = """cProfile of one replay of tests/golden/land_to_sea through all cores:
   python benchmarks/bench_replay.py --profile benchmarks/profiles/replay_through_cores.txt
 Before issue 16's replay work the bag was opened twice (anchor pass + replay) and one
@@ -167,10 +227,16 @@ def main() -> None:
     parser.add_argument('--profile', default=None,
                         help='cProfile one replay of land_to_sea through all cores, as text '
                              'to this file, and stop')
+    parser.add_argument('--phases', action='store_true',
+                        help="print land_to_sea's replay phases (reading, decoding, each "
+                             "core's feeding) and stop")
     parser.add_argument('--profile-estimator', default=None,
                         help="cProfile the estimator alone on land_to_sea's inputs (the "
                              "'bound' line's work), as text to this file, and stop")
     args = parser.parse_args()
+    if args.phases:
+        print_phases(GOLDEN / 'land_to_sea')
+        return
     if args.profile_estimator:
         samples = estimator_inputs(GOLDEN / 'land_to_sea')
         run_estimator(samples, EkfAdapter())                          # warm up

@@ -133,6 +133,8 @@ class _Driver:
         for topic, pending in self._pending.items():
             times_ns, msgs, replayed = zip(*pending, strict=True)
             recorded = self.adapter.recorded_columns(topic, msgs)
+            if not recorded:
+                continue
             mine = _replayed_columns(replayed, tuple(recorded))
             for quantity, theirs in recorded.items():
                 dev = self.deviations.get(quantity)
@@ -209,14 +211,7 @@ BATCH_MESSAGES = 20_000
 
 def _replay(reader: BagReader, bag: Path, adapters: Sequence[CoreAdapter],
             result: ReplayResult) -> None:
-    outputs = set().union(*(a.outputs for a in adapters))
-    firsts = _first_output_ns(reader, outputs)
-    for adapter in adapters:
-        if not any(o in firsts for o in adapter.outputs):
-            raise BagError(f'{bag}: no recorded {list(adapter.outputs)} to anchor the '
-                           f'{adapter.name} replay on')
-    drivers = [_Driver(a, min(firsts[o] for o in a.outputs if o in firsts)) for a in adapters]
-    wanted = outputs.union(*(a.inputs for a in adapters))
+    drivers, wanted = _drivers(reader, bag, adapters)
     start, start_cpu = time.perf_counter(), time.thread_time()
     result.messages, last_ns = _feed_bag(reader, wanted, drivers)
     if last_ns is not None:     # every driver ticks up to the bag's last message
@@ -228,6 +223,20 @@ def _replay(reader: BagReader, bag: Path, adapters: Sequence[CoreAdapter],
         driver.finish()
         result.rows[driver.adapter.name] = driver.rows
         result.deviations[driver.adapter.name] = driver.deviations
+
+
+def _drivers(reader: BagReader, bag: Path, adapters: Sequence[CoreAdapter]
+             ) -> tuple[list[_Driver], set[str]]:
+    """A driver per adapter, its timer anchored on its first recorded output, and the
+    topics any of them reads or compares."""
+    outputs = set().union(*(a.outputs for a in adapters))
+    firsts = _first_output_ns(reader, outputs)
+    for adapter in adapters:
+        if not any(o in firsts for o in adapter.outputs):
+            raise BagError(f'{bag}: no recorded {list(adapter.outputs)} to anchor the '
+                           f'{adapter.name} replay on')
+    drivers = [_Driver(a, min(firsts[o] for o in a.outputs if o in firsts)) for a in adapters]
+    return drivers, outputs.union(*(a.inputs for a in adapters))
 
 
 def _feed_bag(reader: BagReader, wanted: set[str], drivers: Sequence[_Driver]
@@ -282,7 +291,7 @@ def _feed_batch(batch: Sequence[tuple[Connection, int, bytes]], drivers: Sequenc
     """Feed ``batch``'s messages, in order, to the drivers that use them; returns the last
     message's time, ns."""
     with _no_cycle_collection():
-        return _feed_batch_in_order(batch, drivers)
+        return _feed_batch_in_order(batch, drivers, _routes(batch, drivers))
 
 
 @contextmanager
@@ -301,8 +310,7 @@ def _no_cycle_collection() -> Iterator[None]:
 
 
 def _feed_batch_in_order(batch: Sequence[tuple[Connection, int, bytes]],
-                         drivers: Sequence[_Driver]) -> int:
-    routes = _routes(batch, drivers)
+                         drivers: Sequence[_Driver], routes: dict[int, Any]) -> int:
     for conn, t_ns, _ in batch:
         key, steps = routes[conn.id]
         for driver, feeds, compares, take in steps:
