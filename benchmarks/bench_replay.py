@@ -208,7 +208,29 @@ land_circle 28.6 k -> 31.8 k (bit-identical steps) -> 35.6 k msg/s (numba), land
 26.8 k -> 32.0 k -> 36.2 k, sea_to_land 26.7 k -> 31.1 k -> 35.7 k. Not met (>= 50 k): of
 land_to_sea's ~155 ms, reading + decoding + the loop with cores that do nothing are ~35 ms
 (rosbags'), the estimator ~50 ms, its adapter (conversions, rows, comparisons) ~25 ms, the
-drive controller ~21 ms, the mode manager ~4 ms."""
+drive controller ~21 ms, the mode manager ~4 ms.
+Then (branch i16i, 2026-11-27) the replay's per-message work, results bit-identical (rows
+and deviations of every golden bag, all cores and each alone, pickled and compared with
+main's, float types included): each adapter names the fields it reads
+(CoreAdapter.fields) and the replay decodes only those, as numpy columns of a whole
+topic's batch (dukw_bringup.bag_fields: a layout from rosbags' message definitions, checked
+against every message; rosbags per message where they differ), not a rosbags object per
+message; ros_convert's rules take fields (SAMPLE_FROM_MSG reads them from a message with
+one attrgetter: one rule for ekf_node and the replay); recorded outputs are compared batch
+by batch, a quantity over all its messages with numpy (recorded_columns), not a dict per
+message; the cyclic GC is paused while a batch is fed; the IMU sample and motor sides are
+built positionally; the stance detector keeps its sigmas; rosbags' records are batched
+without a BagMessage each. Interleaved with main (19:00-19:02 UTC, CPU clock, best of 7,
+three rounds, load 4.1-4.6): land_circle 126.4 / 128.7 / 123.0 -> 95.1 / 92.7 / 94.2 ms,
+land_to_sea 163.7 / 168.5 / 163.5 -> 123.4 / 125.5 / 127.9 ms (32-33 k -> 42-44 k msg/s),
+sea_to_land 182.8 / 184.2 / 183.4 -> 147.1 / 140.9 / 153.4 ms: about a quarter less, not
+the 30 % that 50 k needs. Phases after (--phases, 19:06, load 4.4): reading 9.8 ms
+(rosbags' MCAP reader; the mcap library's iter_messages is slower), decoding 4.6 ms,
+feeding 111 ms: the loop with idle cores 4.6, mode manager 4.5, drive controller 19.6
+(its step ~12 us x 900), EKF 77.5 of which the estimator ~57-60 (the 'bound' line) and
+its conversions, rows, ticks and comparisons ~12. What limits it: the estimator alone is
+about half of the time; with it as it is, everything else would have to fall under ~45 ms
+for 50 k."""
 
 ESTIMATOR_PROFILE_HEADER = """cProfile of the estimator alone (EkfRunner, odometry and
 traction read per estimate, as the replay does) on tests/golden/land_to_sea's inputs,
@@ -217,7 +239,10 @@ decoded beforehand:
 (branch ekfperf, issue 16) Per message class on the CPU clock see the 'bound' lines.
 (branch i16g, 2026-11-27) The EKF's predict and updates are numba kernels (ekf_kernels: one
 call each, ~1-1.5 us) and the traction query and submersion work on floats: the estimator
-alone on land_to_sea ~91 -> ~50 ms CPU."""
+alone on land_to_sea ~91 -> ~50 ms CPU.
+(branch i16i, 2026-11-27) The stance detector keeps the sigmas of the IMU's variances
+while they stay (3.8 instead of 4.9 us a sample); its inputs here are converted with the
+same ros_convert rules the replay now calls with fields."""
 
 
 def main() -> None:
