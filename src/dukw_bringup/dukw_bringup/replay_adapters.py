@@ -163,7 +163,8 @@ class DriveControllerAdapter(CoreAdapter):
             'drive_mode': (lambda msg, t_s: r.on_mode(c.decision_from_msg(msg), t_s), False),
             'odometry/filtered': (odometry, True),
             'imu/data': (lambda msg, t_s: r.on_imu(c.stamp_or(msg, t_s), t_s), False),
-            'traction': (lambda msg, t_s: r.on_traction(msg.port_slip, msg.stbd_slip, t_s),
+            'traction': (lambda msg, t_s: r.on_traction(msg.port_slip, msg.stbd_slip,
+                                                         msg.weight_on_tracks_fraction, t_s),
                          False),
             'tracks/status': (lambda msg, t_s: r.on_track_status(
                 msg.connected, msg.port.current_a, msg.stbd.current_a, t_s), False)}
