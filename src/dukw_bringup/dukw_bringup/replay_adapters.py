@@ -160,7 +160,8 @@ class DriveControllerAdapter(CoreAdapter):
         'odometry/filtered': ('twist.twist.linear.x', 'twist.twist.angular.z',
                               'pose.pose.orientation.x', 'pose.pose.orientation.y',
                               'pose.pose.orientation.z', 'pose.pose.orientation.w'),
-        'imu/data': STAMP_FIELDS, 'traction': ('port_slip', 'stbd_slip'),
+        'imu/data': STAMP_FIELDS,
+        'traction': ('port_slip', 'stbd_slip', 'weight_on_tracks_fraction'),
         'tracks/status': ('connected', 'port.current_a', 'stbd.current_a'),
         'tracks/cmd': ('port_pct', 'stbd_pct'), 'props/cmd': ('port_pct', 'stbd_pct')})
 
@@ -197,7 +198,7 @@ class DriveControllerAdapter(CoreAdapter):
             'drive_mode': (lambda msg, t_s: r.on_mode(c.decision_from_msg(msg), t_s), False),
             'odometry/filtered': (odometry, True),
             'imu/data': (lambda v, t_s: r.on_imu(stamp_s_or(v[0], v[1], t_s), t_s), False),
-            'traction': (lambda v, t_s: r.on_traction(v[0], v[1], t_s), False),
+            'traction': (lambda v, t_s: r.on_traction(v[0], v[1], v[2], t_s), False),
             'tracks/status': (lambda v, t_s: r.on_track_status(v[0], v[1], v[2], t_s), False)}
 
     def tick(self, t_s):
