@@ -220,14 +220,14 @@ one attrgetter: one rule for ekf_node and the replay); recorded outputs are comp
 by batch, a quantity over all its messages with numpy (recorded_columns), not a dict per
 message; the cyclic GC is paused while a batch is fed; the IMU sample and motor sides are
 built positionally; the stance detector keeps its sigmas; rosbags' records are batched
-without a BagMessage each. Interleaved with main (19:00-19:02 UTC, CPU clock, best of 7,
-three rounds, load 4.1-4.6): land_circle 126.4 / 128.7 / 123.0 -> 95.1 / 92.7 / 94.2 ms,
-land_to_sea 163.7 / 168.5 / 163.5 -> 123.4 / 125.5 / 127.9 ms (32-33 k -> 42-44 k msg/s),
-sea_to_land 182.8 / 184.2 / 183.4 -> 147.1 / 140.9 / 153.4 ms: about a quarter less, not
-the 30 % that 50 k needs. Phases after (--phases, 19:06, load 4.4): reading 9.8 ms
+without a BagMessage each. Interleaved with the branch point 3618656 (19:18-19:19 UTC,
+CPU clock, best of 7, four rounds, load 2.8-4.6): land_circle 117.4-121.3 -> 89.6-94.3 ms,
+land_to_sea 153.6-157.2 -> 120.3-124.9 ms (34-35 k -> 43-45 k msg/s), sea_to_land
+169.8-172.9 -> 134.2-142.3 ms: 17-25 % less per round, not the 30 % that 50 k needs.
+Phases after, merged with main 0566b12 (--phases, 19:23, load 0.8): reading 9.7 ms
 (rosbags' MCAP reader; the mcap library's iter_messages is slower), decoding 4.6 ms,
-feeding 111 ms: the loop with idle cores 4.6, mode manager 4.5, drive controller 19.6
-(its step ~12 us x 900), EKF 77.5 of which the estimator ~57-60 (the 'bound' line) and
+feeding 106 ms: the loop with idle cores 4.8, mode manager 2.2, drive controller 17.7
+(its step ~12 us x 900), EKF 72.1 of which the estimator ~57-60 (the 'bound' line) and
 its conversions, rows, ticks and comparisons ~12. What limits it: the estimator alone is
 about half of the time; with it as it is, everything else would have to fall under ~45 ms
 for 50 k."""
