@@ -31,7 +31,7 @@ def main() -> None:
         ctrl.on_cmd_vel(1.0, 0.1, t)
         ctrl.on_odometry(0.95, 0.09, t)
         ctrl.on_pitch(-0.05, t)
-        ctrl.on_slips(0.1, 0.12, t)
+        ctrl.on_traction(0.1, 0.12, 1.0, t)
         ctrl.on_track_currents(30.0, 32.0, t)
         ctrl.step(t)
 

@@ -11,11 +11,13 @@ from __future__ import annotations
 import argparse
 import tempfile
 import time
+from functools import partial
 from pathlib import Path
 
 from dukw_bringup import bag_io
+from dukw_bringup import replay as replay_module
 from dukw_bringup.replay import replay, stream
-from dukw_bringup.replay_adapters import ADAPTERS, EkfAdapter
+from dukw_bringup.replay_adapters import ADAPTERS, CoreAdapter, EkfAdapter
 from dukw_estimation import ros_convert
 from figures import report
 from profile_text import profile_to_text
@@ -114,6 +116,64 @@ def print_bound(bag: Path, messages: int, rate: float) -> None:
            imu[1] / max(imu[0], 1) * 1e6, 'us', target=100.0)
 
 
+class IdleCore(CoreAdapter):
+    """A core that does nothing, with ``real``'s topics, fields and timer: the replay's
+    reading, decoding and loop around it, without its work."""
+
+    def __init__(self, real: CoreAdapter) -> None:
+        self.name, self.inputs, self.outputs = real.name, real.inputs, real.outputs
+        self.rate_hz, self.fields = real.rate_hz, real.fields
+
+    def feed(self, topic, t_s, msg):
+        return None
+
+    def tick(self, t_s):
+        return None
+
+    def recorded_columns(self, topic, msgs):
+        return {}
+
+
+def replay_phases(bag: Path, adapters: list[CoreAdapter]) -> tuple[float, float, float]:
+    """One replay of ``bag`` (one batch) in its three steps, each on the thread's CPU clock:
+    reading the records, decoding them (every topic's fields as columns, the routes) and
+    feeding them through the cores (their steps, outputs and comparisons). Seconds. Drives
+    dukw_bringup.replay's own steps, as replay() does, apart."""
+    clock = time.thread_time
+    with bag_io.BagReader(bag) as reader:
+        drivers, wanted = replay_module._drivers(reader, bag, adapters)
+        start = clock()
+        batch = list(reader.records(wanted))
+        read = clock()
+        with replay_module._no_cycle_collection():
+            routes = replay_module._routes(batch, drivers)
+            decoded = clock()
+            replay_module._feed_batch_in_order(batch, drivers, routes)
+        return read - start, decoded - read, clock() - decoded
+
+
+def print_phases(bag: Path, repeat: int = 7) -> None:
+    """The phases of a replay through all cores, and each core's own feeding (the others
+    idle), best of ``repeat`` each."""
+    def best(make) -> list[float]:
+        runs = [replay_phases(bag, make()) for _ in range(repeat)]
+        return [min(run[k] for run in runs) * 1e3 for k in range(3)]
+    best(lambda: [f() for f in ADAPTERS.values()])                      # warm up
+    read, decode, feed = best(lambda: [f() for f in ADAPTERS.values()])
+    print(f'phases  : {bag.name:<16} all cores: read {read:.1f} ms, decode {decode:.1f} ms, '
+          f'feed {feed:.1f} ms (CPU clock, best of {repeat} each)')
+    idle = best(lambda: [IdleCore(f()) for f in ADAPTERS.values()])[2]
+    own = {name: best(partial(_alone, name))[2] - idle for name in ADAPTERS}
+    print(f"          feeding: the loop with idle cores {idle:.1f} ms; each core's own work "
+          '(its steps, conversions, rows, comparisons): '
+          + ', '.join(f'{name} {ms:.1f} ms' for name, ms in own.items()))
+
+
+def _alone(name: str) -> list[CoreAdapter]:
+    """The core ``name`` and the others idle."""
+    return [ADAPTERS[n]() if n == name else IdleCore(ADAPTERS[n]()) for n in ADAPTERS]
+
+
 PROFILE_HEADER = """cProfile of one replay of tests/golden/land_to_sea through all cores:
   python benchmarks/bench_replay.py --profile benchmarks/profiles/replay_through_cores.txt
 Before issue 16's replay work the bag was opened twice (anchor pass + replay) and one
@@ -148,7 +208,29 @@ land_circle 28.6 k -> 31.8 k (bit-identical steps) -> 35.6 k msg/s (numba), land
 26.8 k -> 32.0 k -> 36.2 k, sea_to_land 26.7 k -> 31.1 k -> 35.7 k. Not met (>= 50 k): of
 land_to_sea's ~155 ms, reading + decoding + the loop with cores that do nothing are ~35 ms
 (rosbags'), the estimator ~50 ms, its adapter (conversions, rows, comparisons) ~25 ms, the
-drive controller ~21 ms, the mode manager ~4 ms."""
+drive controller ~21 ms, the mode manager ~4 ms.
+Then (branch i16i, 2026-11-27) the replay's per-message work, results bit-identical (rows
+and deviations of every golden bag, all cores and each alone, pickled and compared with
+main's, float types included): each adapter names the fields it reads
+(CoreAdapter.fields) and the replay decodes only those, as numpy columns of a whole
+topic's batch (dukw_bringup.bag_fields: a layout from rosbags' message definitions, checked
+against every message; rosbags per message where they differ), not a rosbags object per
+message; ros_convert's rules take fields (SAMPLE_FROM_MSG reads them from a message with
+one attrgetter: one rule for ekf_node and the replay); recorded outputs are compared batch
+by batch, a quantity over all its messages with numpy (recorded_columns), not a dict per
+message; the cyclic GC is paused while a batch is fed; the IMU sample and motor sides are
+built positionally; the stance detector keeps its sigmas; rosbags' records are batched
+without a BagMessage each. Interleaved with the branch point 3618656 (19:18-19:19 UTC,
+CPU clock, best of 7, four rounds, load 2.8-4.6): land_circle 117.4-121.3 -> 89.6-94.3 ms,
+land_to_sea 153.6-157.2 -> 120.3-124.9 ms (34-35 k -> 43-45 k msg/s), sea_to_land
+169.8-172.9 -> 134.2-142.3 ms: 17-25 % less per round, not the 30 % that 50 k needs.
+Phases after, merged with main 0566b12 (--phases, 19:23, load 0.8): reading 9.7 ms
+(rosbags' MCAP reader; the mcap library's iter_messages is slower), decoding 4.6 ms,
+feeding 106 ms: the loop with idle cores 4.8, mode manager 2.2, drive controller 17.7
+(its step ~12 us x 900), EKF 72.1 of which the estimator ~57-60 (the 'bound' line) and
+its conversions, rows, ticks and comparisons ~12. What limits it: the estimator alone is
+about half of the time; with it as it is, everything else would have to fall under ~45 ms
+for 50 k."""
 
 ESTIMATOR_PROFILE_HEADER = """cProfile of the estimator alone (EkfRunner, odometry and
 traction read per estimate, as the replay does) on tests/golden/land_to_sea's inputs,
@@ -157,7 +239,10 @@ decoded beforehand:
 (branch ekfperf, issue 16) Per message class on the CPU clock see the 'bound' lines.
 (branch i16g, 2026-11-27) The EKF's predict and updates are numba kernels (ekf_kernels: one
 call each, ~1-1.5 us) and the traction query and submersion work on floats: the estimator
-alone on land_to_sea ~91 -> ~50 ms CPU."""
+alone on land_to_sea ~91 -> ~50 ms CPU.
+(branch i16i, 2026-11-27) The stance detector keeps the sigmas of the IMU's variances
+while they stay (3.8 instead of 4.9 us a sample); its inputs here are converted with the
+same ros_convert rules the replay now calls with fields."""
 
 
 def main() -> None:
@@ -167,10 +252,16 @@ def main() -> None:
     parser.add_argument('--profile', default=None,
                         help='cProfile one replay of land_to_sea through all cores, as text '
                              'to this file, and stop')
+    parser.add_argument('--phases', action='store_true',
+                        help="print land_to_sea's replay phases (reading, decoding, each "
+                             "core's feeding) and stop")
     parser.add_argument('--profile-estimator', default=None,
                         help="cProfile the estimator alone on land_to_sea's inputs (the "
                              "'bound' line's work), as text to this file, and stop")
     args = parser.parse_args()
+    if args.phases:
+        print_phases(GOLDEN / 'land_to_sea')
+        return
     if args.profile_estimator:
         samples = estimator_inputs(GOLDEN / 'land_to_sea')
         run_estimator(samples, EkfAdapter())                          # warm up

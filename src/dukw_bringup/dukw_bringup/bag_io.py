@@ -384,14 +384,21 @@ class BagReader:
 
     def messages(self, topics: Iterable[str] | None = None) -> Iterator[BagMessage]:
         """The bag's messages in time order, optionally only of ``topics``."""
+        for conn, timestamp, raw in self.records(topics):
+            yield BagMessage(conn.topic, conn.msgtype, timestamp,
+                             raw if type(raw) is bytes else bytes(raw))
+
+    def records(self, topics: Iterable[str] | None = None
+                ) -> Iterator[tuple[Connection, int, bytes | memoryview]]:
+        """rosbags' own (connection, receive time ns, CDR bytes) in time order, optionally
+        only of ``topics``: ``messages`` without a BagMessage made per message (the replay
+        groups them by connection)."""
         wanted = None if topics is None else {topic_key(t) for t in topics}
         conns = [c for c in self.reader.connections
                  if wanted is None or topic_key(c.topic) in wanted]
         if wanted is not None and not conns:
-            return
-        for conn, timestamp, raw in self.reader.messages(connections=conns):
-            yield BagMessage(conn.topic, conn.msgtype, timestamp,
-                             raw if type(raw) is bytes else bytes(raw))
+            return iter(())
+        return self.reader.messages(connections=conns)
 
 
 def deserialize(message: BagMessage, store: Typestore | None = None) -> Any:

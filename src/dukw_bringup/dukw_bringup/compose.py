@@ -127,7 +127,8 @@ def estimate_handoff(ekf: Node, mode_manager: Node | None, controller: Node | No
                 odom.surge_mps, odom.yaw_rate_rps, odom.pitch_rad, now))
         traction = estimate.traction        # (read from the estimator only now)
         if controller is not None:
-            controller.runner.on_traction(traction.port_slip, traction.stbd_slip, now)
+            controller.runner.on_traction(traction.port_slip, traction.stbd_slip,
+                                         traction.weight_on_tracks_fraction, now)
         if mode_manager is not None:
             mode_manager.runner.on_traction(traction.weight_on_tracks_fraction, now)
     return on_estimate

@@ -16,16 +16,26 @@ from __future__ import annotations
 
 import argparse
 import csv
+import gc
 import math
 import sys
 import time
+from collections import defaultdict
+from contextlib import contextmanager
+from itertools import islice
 from dataclasses import dataclass, field
+from operator import itemgetter
 from pathlib import Path
-from typing import Any, Callable, Iterable, Sequence
+from typing import Any, Callable, Iterable, Iterator, Sequence
 
+import numpy as np
+
+from dukw_bringup.bag_fields import read_fields
 from dukw_bringup.bag_io import (BagError, BagReader, deserialize, read_messages, topic_key,
                                  typestore)
 from dukw_bringup.replay_adapters import ADAPTERS, CoreAdapter
+from rosbags.interfaces import Connection
+from rosbags.typesys.store import Typestore
 
 
 @dataclass
@@ -91,8 +101,8 @@ class _Driver:
         self.latest: dict[str, float] | None = None
         self.rows: list[dict[str, float]] = []
         self.deviations: dict[str, Deviation] = {}
-        #: per compared topic: its quantities, exact matches not yet counted, their deviations
-        self._matched: dict[str, list[Any]] = {}
+        #: per compared topic: (time ns, recorded message, latest replayed row) not compared
+        self._pending: defaultdict[str, list[tuple[int, Any, Any]]] = defaultdict(list)
 
     def run_ticks_until(self, t_ns: int, inclusive: bool) -> None:
         if self.next_tick_ns is None:
@@ -113,44 +123,64 @@ class _Driver:
             self.rows.append({'t_s': t_s, **out})
 
     def compare(self, topic: str, t_ns: int, msg: Any) -> None:
-        recorded = self.adapter.recorded(topic, msg)
-        replayed = self.latest or {}
-        matched = self._matched.get(topic)
-        # every quantity as replayed, bit for bit (the usual case): only the counts move,
-        # added in ``finish`` (a dict items view compares in C: no loop here)
-        if matched is not None and matched[0] == recorded.keys() and \
-                recorded.items() <= replayed.items():
-            matched[1] += 1
-            return
-        self._compare(recorded, replayed, t_ns)
-        if matched is None:      # the first time: from now on the fast path can count them
-            self._matched[topic] = [recorded.keys(), 0, [self.deviations[q] for q in recorded]]
+        """Note a recorded output and the latest replayed one (``settle`` compares)."""
+        self._pending[topic].append((t_ns, msg, self.latest))
 
-    def _compare(self, recorded: dict[str, float], replayed: dict[str, float],
-                 t_ns: int) -> None:
-        deviations, angles, nan = self.deviations, self.adapter.angle_quantities, math.nan
-        for quantity, value in recorded.items():
-            dev = deviations.get(quantity)
-            if dev is None:     # (not setdefault: it would build a Deviation every time)
-                dev = deviations[quantity] = Deviation(self.adapter.name, quantity)
-            mine = replayed.get(quantity, nan)
-            diff = abs(mine - value)
-            if diff != diff:                  # NaN: both NaN is a match, one NaN is not
-                if mine != mine and value != value:
-                    diff = 0.0
-            elif diff > math.pi and quantity in angles:
-                diff = abs(math.remainder(mine - value, math.tau))
-            compared = dev.compared = dev.compared + 1
-            worst = dev.max_abs
-            if compared == 1 or diff > worst or (diff != diff and worst == worst):
-                dev.max_abs, dev.at_s, dev.replayed, dev.recorded = diff, t_ns * 1e-9, mine, value
+    def settle(self) -> None:
+        """Compare the outputs noted since the last call, each quantity over all of them at
+        once (the adapter's ``recorded_columns``, numpy for the differences)."""
+        angles = self.adapter.angle_quantities
+        for topic, pending in self._pending.items():
+            times_ns, msgs, replayed = zip(*pending, strict=True)
+            recorded = self.adapter.recorded_columns(topic, msgs)
+            if not recorded:
+                continue
+            mine = _replayed_columns(replayed, tuple(recorded))
+            for quantity, theirs in recorded.items():
+                dev = self.deviations.get(quantity)
+                if dev is None:
+                    dev = self.deviations[quantity] = Deviation(self.adapter.name, quantity)
+                _fold(dev, times_ns, mine[quantity], theirs, quantity in angles)
+        self._pending.clear()
 
     def finish(self) -> None:
-        """Add the comparisons the fast path only counted to their deviations."""
-        for _, count, devs in self._matched.values():
-            for dev in devs:
-                dev.compared += count
-        self._matched.clear()
+        """Compare what is still noted."""
+        self.settle()
+
+
+def _replayed_columns(rows: Sequence[dict[str, float] | None], quantities: tuple[str, ...]
+                      ) -> dict[str, Sequence[float]]:
+    """Per quantity, its value in each replayed row (NaN where a row lacks it or is None)."""
+    try:
+        get = itemgetter(*quantities)
+        values = [get(row) for row in rows]        # (one C call per row: the usual case)
+        if len(quantities) == 1:
+            values = [(v,) for v in values]
+    except (KeyError, TypeError):
+        values = [tuple(math.nan if row is None else row.get(q, math.nan) for q in quantities)
+                  for row in rows]
+    return dict(zip(quantities, zip(*values, strict=True), strict=True))
+
+
+def _fold(dev: Deviation, times_ns: Sequence[int], mine: Sequence[float],
+          theirs: Sequence[float], angle: bool) -> None:
+    """Fold comparisons into ``dev`` as one by one in order would: |replayed - recorded|
+    (both NaN: 0, one NaN: NaN; an angle modulo 2 pi), the first worst kept, NaN worst of
+    all."""
+    replayed, recorded = np.asarray(mine, dtype=float), np.asarray(theirs, dtype=float)
+    diff = np.abs(replayed - recorded)
+    diff[np.isnan(replayed) & np.isnan(recorded)] = 0.0
+    if angle:
+        for k in np.flatnonzero(diff > math.pi):
+            diff[k] = abs(math.remainder(float(replayed[k]) - float(recorded[k]), math.tau))
+    nan = np.isnan(diff)
+    k = int(np.argmax(nan)) if nan.any() else int(np.argmax(diff))
+    worst = float(diff[k])
+    first = dev.compared == 0
+    dev.compared += len(diff)
+    if first or worst > dev.max_abs or (worst != worst and dev.max_abs == dev.max_abs):
+        dev.max_abs, dev.at_s = worst, times_ns[k] * 1e-9
+        dev.replayed, dev.recorded = float(replayed[k]), float(recorded[k])
 
 
 def _first_output_ns(bag: BagReader, topics: set[str]) -> dict[str, int]:
@@ -175,42 +205,15 @@ def replay(bag: str | Path, adapters: Sequence[CoreAdapter]) -> ReplayResult:
     return result
 
 
+#: messages read, decoded and fed per batch (a long bag is never held whole)
+BATCH_MESSAGES = 20_000
+
+
 def _replay(reader: BagReader, bag: Path, adapters: Sequence[CoreAdapter],
             result: ReplayResult) -> None:
-    store = typestore()
-    outputs = set().union(*(a.outputs for a in adapters))
-    firsts = _first_output_ns(reader, outputs)
-    for adapter in adapters:
-        if not any(o in firsts for o in adapter.outputs):
-            raise BagError(f'{bag}: no recorded {list(adapter.outputs)} to anchor the '
-                           f'{adapter.name} replay on')
-    drivers = [_Driver(a, min(firsts[o] for o in a.outputs if o in firsts)) for a in adapters]
-    wanted = outputs.union(*(a.inputs for a in adapters))
-    routes: dict[str, tuple[str, list[tuple[_Driver, bool, bool]]]] = {}
-    decode = store.deserialize_cdr       # (bag_io.deserialize without its per-call lookup)
-    last_ns = None
+    drivers, wanted = _drivers(reader, bag, adapters)
     start, start_cpu = time.perf_counter(), time.thread_time()
-    for topic, msgtype, t_ns, raw in reader.messages(wanted):
-        route = routes.get(topic)
-        if route is None:       # each topic's key and the drivers that use it
-            key = topic_key(topic)
-            route = routes[topic] = (key, [
-                (d, key in d.adapter.inputs, key in d.adapter.outputs) for d in drivers
-                if key in d.adapter.inputs or key in d.adapter.outputs])
-        key, steps = route
-        msg = decode(raw, msgtype)
-        result.messages += 1
-        last_ns = t_ns
-        for driver, feeds, compares in steps:
-            # a driver's ticks run when its next message comes (the cores are independent:
-            # the same ticks, in the same order with its own messages, as at every message)
-            if driver.next_tick_ns is not None and driver.next_tick_ns < t_ns:
-                driver.run_ticks_until(t_ns, inclusive=False)
-            if feeds:
-                driver.feed(key, t_ns, msg)
-            if compares:
-                driver.run_ticks_until(t_ns, inclusive=True)
-                driver.compare(key, t_ns, msg)
+    result.messages, last_ns = _feed_bag(reader, wanted, drivers)
     if last_ns is not None:     # every driver ticks up to the bag's last message
         for driver in drivers:
             driver.run_ticks_until(last_ns, inclusive=False)
@@ -220,6 +223,110 @@ def _replay(reader: BagReader, bag: Path, adapters: Sequence[CoreAdapter],
         driver.finish()
         result.rows[driver.adapter.name] = driver.rows
         result.deviations[driver.adapter.name] = driver.deviations
+
+
+def _drivers(reader: BagReader, bag: Path, adapters: Sequence[CoreAdapter]
+             ) -> tuple[list[_Driver], set[str]]:
+    """A driver per adapter, its timer anchored on its first recorded output, and the
+    topics any of them reads or compares."""
+    outputs = set().union(*(a.outputs for a in adapters))
+    firsts = _first_output_ns(reader, outputs)
+    for adapter in adapters:
+        if not any(o in firsts for o in adapter.outputs):
+            raise BagError(f'{bag}: no recorded {list(adapter.outputs)} to anchor the '
+                           f'{adapter.name} replay on')
+    drivers = [_Driver(a, min(firsts[o] for o in a.outputs if o in firsts)) for a in adapters]
+    return drivers, outputs.union(*(a.inputs for a in adapters))
+
+
+def _feed_bag(reader: BagReader, wanted: set[str], drivers: Sequence[_Driver]
+              ) -> tuple[int, int | None]:
+    """Every wanted message, batch by batch; returns (messages, the last one's time ns)."""
+    count, last_ns, records = 0, None, reader.records(wanted)
+    while batch := list(islice(records, BATCH_MESSAGES)):
+        count, last_ns = count + len(batch), _feed_batch(batch, drivers)
+    return count, last_ns
+
+
+def _routes(batch: Sequence[tuple[Connection, int, bytes]], drivers: Sequence[_Driver]
+            ) -> dict[int, tuple[str, list[tuple[_Driver, bool, bool, Callable[[], Any]]]]]:
+    """Per connection (topic) of ``batch``, by its id: the topic's key and, for each driver
+    that uses it, (driver, feeds, compares, the next of its messages as the driver reads
+    them). A driver that names the fields it reads (``CoreAdapter.fields``) gets them as a
+    tuple, decoded for the whole batch at once (bag_fields); one that does not gets
+    rosbags' message object."""
+    store = typestore()
+    raws: dict[int, list[bytes]] = {}
+    connections: dict[int, Connection] = {}
+    for conn, _, raw in batch:
+        topic_raws = raws.get(conn.id)
+        if topic_raws is None:
+            topic_raws = raws[conn.id] = []
+            connections[conn.id] = conn
+        topic_raws.append(raw)
+    routes = {}
+    for conn_id, topic_raws in raws.items():
+        conn = connections[conn_id]
+        key = topic_key(conn.topic)
+        users = [d for d in drivers if key in d.adapter.inputs or key in d.adapter.outputs]
+        decoded = {paths: _decoded(store, conn.msgtype, topic_raws, paths)
+                   for paths in {d.adapter.fields.get(key) for d in users}}
+        routes[conn_id] = (key, [(d, key in d.adapter.inputs, key in d.adapter.outputs,
+                                  iter(decoded[d.adapter.fields.get(key)]).__next__)
+                                 for d in users])
+    return routes
+
+
+def _decoded(store: Typestore, msgtype: str, raws: Sequence[bytes],
+             paths: tuple[str, ...] | None) -> list[Any]:
+    """Messages as a driver reads them: tuples of the fields ``paths``, or (None) rosbags'
+    message objects."""
+    if paths:
+        return read_fields(store, msgtype, raws, paths)
+    return [store.deserialize_cdr(raw, msgtype) for raw in raws]
+
+
+def _feed_batch(batch: Sequence[tuple[Connection, int, bytes]], drivers: Sequence[_Driver]
+                ) -> int:
+    """Feed ``batch``'s messages, in order, to the drivers that use them; returns the last
+    message's time, ns."""
+    with _no_cycle_collection():
+        return _feed_batch_in_order(batch, drivers, _routes(batch, drivers))
+
+
+@contextmanager
+def _no_cycle_collection() -> Iterator[None]:
+    """The cyclic garbage collector paused (as it was after): the replay allocates tens of
+    thousands of rows and tuples, none in a cycle (reference counting frees them), and each
+    time they pass its thresholds it scans every object of the process (~170,000 with the
+    stack's modules loaded), 10-20 ms a full pass, for nothing."""
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
+
+
+def _feed_batch_in_order(batch: Sequence[tuple[Connection, int, bytes]],
+                         drivers: Sequence[_Driver], routes: dict[int, Any]) -> int:
+    for conn, t_ns, _ in batch:
+        key, steps = routes[conn.id]
+        for driver, feeds, compares, take in steps:
+            msg = take()
+            # a driver's ticks run when its next message comes (the cores are independent:
+            # the same ticks, in the same order with its own messages, as at every message)
+            if driver.next_tick_ns is not None and driver.next_tick_ns < t_ns:
+                driver.run_ticks_until(t_ns, inclusive=False)
+            if feeds:
+                driver.feed(key, t_ns, msg)
+            if compares:
+                driver.run_ticks_until(t_ns, inclusive=True)
+                driver.compare(key, t_ns, msg)
+    for driver in drivers:
+        driver.settle()
+    return batch[-1][1]
 
 
 def stream(bag: str | Path, decode: bool = False,

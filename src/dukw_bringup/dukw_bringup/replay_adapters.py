@@ -4,16 +4,24 @@ Each adapter converts a bag's messages as its node does (the same conversion fun
 and hands them to the node's runner, which owns the node's schedule: what it does on each
 input and on each timer tick. The adapter only turns the runner's outputs and the
 recorded messages into named numbers to compare.
+
+An adapter names the message fields it reads per topic (``fields``): the replay decodes
+only those, as columns of all of a topic's messages at once (dukw_bringup.bag_fields),
+and hands each message over as the tuple of them. A topic not in ``fields`` comes as
+rosbags' message object (a type that varies, e.g. cmd_vel's Twist or TwistStamped, or a
+string the core reads).
 """
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from operator import attrgetter
-from typing import Any, Callable
+from types import MappingProxyType
+from typing import Any, Callable, Mapping, Sequence
 
 from dukw_common.cmd_vel import read_cmd_vel
 from dukw_common.config import node_params
 from dukw_common.geometry import euler_from_quaternion
+from dukw_common.node_tools import STAMP_FIELDS, stamp_s_or
 from dukw_control import convert as control_convert
 from dukw_control.controller import ControlOutput
 from dukw_control.modes import ModeDecision
@@ -35,10 +43,14 @@ class CoreAdapter(ABC):
     rate_hz: float = 1.0
     #: quantities that are angles, rad: compared modulo 2 pi
     angle_quantities: frozenset[str] = frozenset()
+    #: topic key -> the message fields (dotted paths) ``feed``/``recorded`` read, in the
+    #: order of the tuple they get; a topic not here: rosbags' message object
+    fields: Mapping[str, tuple[str, ...]] = MappingProxyType({})
 
     @abstractmethod
     def feed(self, topic: str, t_s: float, msg: Any) -> dict[str, float] | None:
-        """An input message received at ``t_s`` (bag time, s).
+        """An input message received at ``t_s`` (bag time, s): the tuple of its ``fields``
+        (or the message).
 
         Return an output when the node reacts at once (outside its timer), else None.
         """
@@ -48,9 +60,21 @@ class CoreAdapter(ABC):
         """The node's timer at ``t_s``: step the core and return its output as named
         numbers, or None when the node skips this tick (publishes nothing)."""
 
-    @abstractmethod
     def recorded(self, topic: str, msg: Any) -> dict[str, float]:
-        """The same named numbers from a recorded output message on ``topic``."""
+        """The same named numbers from a recorded output message on ``topic`` (the tuple of
+        its ``fields``, or the message). Implement this or ``recorded_columns``."""
+        raise NotImplementedError(f'{self.name}: neither recorded nor recorded_columns')
+
+    def recorded_columns(self, topic: str, msgs: Sequence[Any]) -> dict[str, Sequence[float]]:
+        """Per quantity, its values in the recorded output messages ``msgs`` on ``topic``
+        (the replay compares many at once); by default ``recorded`` of each, which must name
+        the same quantities every time."""
+        rows = [self.recorded(topic, msg) for msg in msgs]
+        names = rows[0].keys()
+        if any(row.keys() != names for row in rows):
+            raise ValueError(f'{self.name}: the recorded {topic} quantities differ from one '
+                             'message to the next')
+        return {name: [row[name] for row in rows] for name in names}
 
 
 def _side_row(prefix: str, port: float, stbd: float) -> dict[str, float]:
@@ -83,6 +107,12 @@ class ModeManagerAdapter(CoreAdapter):
     name = 'mode_manager'
     inputs = ('water/contact', 'depth', 'traction', 'tracks/status', 'imu/data')
     outputs = ('drive_mode',)
+    fields = MappingProxyType({
+        'water/contact': ('fore_wet', 'aft_wet'), 'depth': ('valid', 'depth_m'),
+        'traction': ('weight_on_tracks_fraction',),
+        'tracks/status': ('connected', 'port.force_n', 'stbd.force_n'),
+        'imu/data': STAMP_FIELDS,
+        'drive_mode': ('mode', 'automatic', 'track_weight', 'prop_weight', 'tracks_idle')})
 
     def __init__(self, config_path: str | None = None,
                  runner: ModeManagerRunner | None = None) -> None:
@@ -102,12 +132,11 @@ class ModeManagerAdapter(CoreAdapter):
         """Per input topic: message -> runner call (a lookup, not a chain of ifs)."""
         r = self.runner
         return {
-            'water/contact': lambda msg, t_s: r.on_water_contact(msg.fore_wet, msg.aft_wet, t_s),
-            'depth': lambda msg, t_s: r.on_depth(msg.valid, msg.depth_m, t_s),
-            'traction': lambda msg, t_s: r.on_traction(msg.weight_on_tracks_fraction, t_s),
-            'tracks/status': lambda msg, t_s: r.on_track_status(
-                msg.connected, msg.port.force_n, msg.stbd.force_n, t_s),
-            'imu/data': lambda msg, t_s: r.on_imu(control_convert.stamp_or(msg, t_s), t_s)}
+            'water/contact': lambda v, t_s: r.on_water_contact(v[0], v[1], t_s),
+            'depth': lambda v, t_s: r.on_depth(v[0], v[1], t_s),
+            'traction': lambda v, t_s: r.on_traction(v[0], t_s),
+            'tracks/status': lambda v, t_s: r.on_track_status(v[0], v[1], v[2], t_s),
+            'imu/data': lambda v, t_s: r.on_imu(stamp_s_or(v[0], v[1], t_s), t_s)}
 
     def tick(self, t_s):
         """Every tick's decision is compared (the node publishes only some of them)."""
@@ -115,8 +144,7 @@ class ModeManagerAdapter(CoreAdapter):
         return decision_row(self.core.decision())
 
     def recorded(self, topic, msg):
-        return _decision_row(msg.mode, msg.automatic, msg.track_weight, msg.prop_weight,
-                             msg.tracks_idle)
+        return _decision_row(*msg)
 
 
 class DriveControllerAdapter(CoreAdapter):
@@ -126,6 +154,16 @@ class DriveControllerAdapter(CoreAdapter):
     inputs = ('cmd_vel', 'authority', 'drive_mode', 'odometry/filtered', 'imu/data',
               'traction', 'tracks/status')
     outputs = ('tracks/cmd', 'props/cmd')
+    #: (cmd_vel, authority and drive_mode come as messages: the first's type varies, the
+    #: others carry the strings the core reads; they are few)
+    fields = MappingProxyType({
+        'odometry/filtered': ('twist.twist.linear.x', 'twist.twist.angular.z',
+                              'pose.pose.orientation.x', 'pose.pose.orientation.y',
+                              'pose.pose.orientation.z', 'pose.pose.orientation.w'),
+        'imu/data': STAMP_FIELDS,
+        'traction': ('port_slip', 'stbd_slip', 'weight_on_tracks_fraction'),
+        'tracks/status': ('connected', 'port.current_a', 'stbd.current_a'),
+        'tracks/cmd': ('port_pct', 'stbd_pct'), 'props/cmd': ('port_pct', 'stbd_pct')})
 
     def __init__(self, config_path: str | None = None,
                  runner: DriveControllerRunner | None = None) -> None:
@@ -151,22 +189,17 @@ class DriveControllerAdapter(CoreAdapter):
             speed_mps, yaw_rate_rps, stamp_s = read_cmd_vel(msg)
             r.on_cmd_vel(speed_mps, yaw_rate_rps, t_s, stamp_s)
 
-        def odometry(msg, t_s):
-            twist = msg.twist.twist
-            return control_row(r.on_odometry(twist.linear.x, twist.angular.z,
-                                             c.pitch_from_quaternion(msg.pose.pose.orientation),
-                                             t_s))
+        def odometry(v, t_s):
+            return control_row(r.on_odometry(v[0], v[1], c.quaternion_pitch_rad(*v[2:]), t_s))
         return {
             'cmd_vel': (cmd_vel, False),
             'authority': (lambda msg, t_s: control_row(r.on_authority(
                 *c.authority_usable(msg), t_s)), True),
             'drive_mode': (lambda msg, t_s: r.on_mode(c.decision_from_msg(msg), t_s), False),
             'odometry/filtered': (odometry, True),
-            'imu/data': (lambda msg, t_s: r.on_imu(c.stamp_or(msg, t_s), t_s), False),
-            'traction': (lambda msg, t_s: r.on_traction(msg.port_slip, msg.stbd_slip, t_s),
-                         False),
-            'tracks/status': (lambda msg, t_s: r.on_track_status(
-                msg.connected, msg.port.current_a, msg.stbd.current_a, t_s), False)}
+            'imu/data': (lambda v, t_s: r.on_imu(stamp_s_or(v[0], v[1], t_s), t_s), False),
+            'traction': (lambda v, t_s: r.on_traction(v[0], v[1], v[2], t_s), False),
+            'tracks/status': (lambda v, t_s: r.on_track_status(v[0], v[1], v[2], t_s), False)}
 
     def tick(self, t_s):
         return control_row(self.runner.tick(t_s))
@@ -174,23 +207,33 @@ class DriveControllerAdapter(CoreAdapter):
     #: recorded output topic -> its row names (made once, not per message)
     _ROW_NAMES = {topic: tuple(_side_row(topic.split('/')[0], 0.0, 0.0)) for topic in outputs}
 
-    def recorded(self, topic, msg):
+    def recorded_columns(self, topic, msgs):
         port_name, stbd_name = self._ROW_NAMES[topic]
-        return {port_name: float(msg.port_pct), stbd_name: float(msg.stbd_pct)}
+        port_pct, stbd_pct = zip(*msgs, strict=True)
+        return {port_name: port_pct, stbd_name: stbd_pct}
+
+
+#: nav_msgs/Odometry's fields the EKF's rows compare
+_ODOMETRY_FIELDS = ('pose.pose.position.x', 'pose.pose.position.y', 'pose.pose.orientation.x',
+                    'pose.pose.orientation.y', 'pose.pose.orientation.z',
+                    'pose.pose.orientation.w', 'twist.twist.linear.x', 'twist.twist.angular.z')
 
 
 class EkfAdapter(CoreAdapter):
     """ekf_node's runner (dukw_estimation.runner.EkfRunner)."""
 
     name = 'ekf'
-    inputs = tuple(ros_convert.SAMPLE_FROM_MSG)
+    inputs = tuple(ros_convert.SAMPLE_FROM_FIELDS)
     outputs = ('odometry/filtered', 'traction')
     angle_quantities = frozenset({'odom.yaw_rad'})
     #: traction fields compared (the message's float fields)
     TRACTION_FIELDS = ros_convert.TRACTION_FIELDS
-    #: their row names, and one call reading them all (a row per estimate: keep it cheap)
+    #: each input's header stamp, then the fields its node's conversion reads
+    fields = MappingProxyType({
+        **{topic: STAMP_FIELDS + ros_convert.SAMPLE_FIELDS[topic] for topic in inputs},
+        'odometry/filtered': _ODOMETRY_FIELDS, 'traction': TRACTION_FIELDS})
+    #: the traction's row names (a row per estimate: made once)
     _TRACTION_KEYS = tuple(f'traction.{name}' for name in TRACTION_FIELDS)
-    _traction_values = staticmethod(attrgetter(*TRACTION_FIELDS))
 
     def __init__(self, config_path: str | None = None, runner: EkfRunner | None = None) -> None:
         self.runner = runner or EkfRunner.from_params(node_params('ekf_node', config_path))
@@ -198,7 +241,9 @@ class EkfAdapter(CoreAdapter):
         self.core = self.runner.estimator
 
     def feed(self, topic, t_s, msg):
-        sample = ros_convert.SAMPLE_FROM_MSG[topic](msg, ros_convert.stamp_or(msg, t_s))
+        """``msg``: the stamp's fields, then the conversion's (as ekf_node converts)."""
+        sample = ros_convert.SAMPLE_FROM_FIELDS[topic](stamp_s_or(msg[0], msg[1], t_s),
+                                                        *msg[2:])
         return self.estimate_row(self.runner.on_sample(topic, sample, t_s))
 
     def tick(self, t_s):
@@ -217,20 +262,16 @@ class EkfAdapter(CoreAdapter):
                        strict=True))
         return row
 
-    @staticmethod
-    def _odometry_row(msg) -> dict[str, float]:
-        q = msg.pose.pose.orientation
-        return {'odom.x_m': float(msg.pose.pose.position.x),
-                'odom.y_m': float(msg.pose.pose.position.y),
-                'odom.yaw_rad': float(euler_from_quaternion(q.x, q.y, q.z, q.w)[2]),
-                'odom.surge_mps': float(msg.twist.twist.linear.x),
-                'odom.yaw_rate_rps': float(msg.twist.twist.angular.z)}
+    _traction_values = staticmethod(attrgetter(*TRACTION_FIELDS))
 
-    def recorded(self, topic, msg):
-        if topic == 'odometry/filtered':
-            return self._odometry_row(msg)
-        return dict(zip(self._TRACTION_KEYS, map(float, self._traction_values(msg)),
-                        strict=True))
+    def recorded_columns(self, topic, msgs):
+        columns = tuple(zip(*msgs, strict=True))
+        if topic != 'odometry/filtered':
+            return dict(zip(self._TRACTION_KEYS, columns, strict=True))
+        x_m, y_m, qx, qy, qz, qw, surge_mps, yaw_rate_rps = columns
+        yaw_rad = [euler_from_quaternion(*q)[2] for q in zip(qx, qy, qz, qw, strict=True)]
+        return {'odom.x_m': x_m, 'odom.y_m': y_m, 'odom.yaw_rad': yaw_rad,
+                'odom.surge_mps': surge_mps, 'odom.yaw_rate_rps': yaw_rate_rps}
 
 
 #: adapter name -> factory (config path -> adapter)

@@ -172,7 +172,8 @@ class Stack:
 
     def _traction(self, topic: str, t_ns: int, traction: TractionEstimate) -> None:
         self.mode_manager.on_traction(traction.weight_on_tracks_fraction, t_ns * 1e-9)
-        self.controller.on_traction(traction.port_slip, traction.stbd_slip, t_ns * 1e-9)
+        self.controller.on_traction(traction.port_slip, traction.stbd_slip,
+                                    traction.weight_on_tracks_fraction, t_ns * 1e-9)
 
     def _drive_mode(self, topic: str, t_ns: int, decision: ModeDecision) -> None:
         self.controller.on_mode(decision, t_ns * 1e-9)

@@ -4,6 +4,7 @@ import math
 import pytest
 
 from dukw_bringup import bag_io
+from dukw_bringup import replay as replay_module
 from dukw_bringup.replay import CoreAdapter, main, replay, stream
 
 MS = 1_000_000
@@ -73,6 +74,23 @@ def test_a_moved_output_is_named_with_its_size_and_time(tmp_path):
     text = bad[0].describe()
     assert 'sum.total' in text and 'moved by 0.5' in text and 't=0.200 s' in text
     assert result.exceeding({'sum.total': 0.6}, 0.1) == []
+
+
+@pytest.mark.parametrize('batch_messages', [1, 2, 3, replay_module.BATCH_MESSAGES])
+def test_the_first_worst_deviation_is_named_however_the_bag_is_batched(
+        tmp_path, monkeypatch, batch_messages):
+    # replayed totals 3, 5, 7, 9 at 0.1 .. 0.4 s; the comparisons of many outputs are folded
+    # at once (batch by batch), and must name what comparing one by one in order names
+    monkeypatch.setattr(replay_module, 'BATCH_MESSAGES', batch_messages)
+    moved = _bag(tmp_path / 'moved', [(100, 3.5, 1.0), (200, 6.0, 2.0), (300, 8.0, 3.0)])
+    dev = replay(moved, [SumCore()]).deviations['sum']['total']
+    assert (dev.max_abs, dev.compared, dev.replayed, dev.recorded) == (1.0, 3, 5.0, 6.0)
+    assert dev.at_s == pytest.approx(0.2)               # the first of the two 1.0s
+    lost = _bag(tmp_path / 'lost', [(100, 3.0, 1.0), (200, math.nan, 2.0), (300, 17.0, 3.0),
+                                    (400, math.nan, 4.0)])
+    dev = replay(lost, [SumCore()]).deviations['sum']['total']
+    assert math.isnan(dev.max_abs) and dev.at_s == pytest.approx(0.2) and dev.compared == 4
+    assert replay(lost, [SumCore()]).deviations['sum']['ticks'].max_abs == 0.0
 
 
 def test_nan_on_one_side_is_a_deviation(tmp_path):

@@ -340,3 +340,17 @@ def test_the_main_jobs_mission_climbs_out_of_the_swash(index):
     assert row['mission_done'], f"stuck at x = {row['end_x_m']:.2f} m"
     assert row['mission_time_s'] < 150.0
     assert row['time_over_limit_s'] < 30.0
+
+
+@pytest.mark.slow
+def test_a_slow_approach_with_the_allowance_spent_still_climbs_out_of_the_swash():
+    """config/campaigns/beach_exit.yaml run 10: sea-to-land at 0.63 m/s into the day-1 sea.
+    It stalled at x 1.8 m (56 s over 35 A): the spent limiter derated the tracks to ~20 %,
+    belts slower than the swash's uprush, which they braked; the motor now rests and
+    bursts (current.rest_below_scale) and the grounded props push instead of steering."""
+    from dukw_common.config import default_config_path
+    path = default_config_path().parent / 'campaigns' / 'beach_exit.yaml'
+    row = campaign.run_one(campaign.load_spec(str(path)), 10)
+    assert not row['error']
+    assert row['speed_mps'] == pytest.approx(0.63, abs=0.01)   # the slow one it was
+    assert row['end_x_m'] < -5.0, f"stuck at x = {row['end_x_m']:.2f} m"

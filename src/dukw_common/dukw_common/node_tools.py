@@ -324,6 +324,17 @@ def stamp_to_s(stamp) -> float:
     return stamp.sec + stamp.nanosec * 1e-9
 
 
+#: a header stamp's fields, as ``stamp_s_or`` takes them (readers that take fields)
+STAMP_FIELDS = ('header.stamp.sec', 'header.stamp.nanosec')
+
+
+def stamp_s_or(sec: int, nanosec: int, fallback_s: float) -> float:
+    """A header stamp in seconds (as ``stamp_to_s``), or ``fallback_s`` when it is unset
+    (zero)."""
+    t_s = sec + nanosec * 1e-9
+    return t_s if t_s > 0.0 else fallback_s
+
+
 def s_to_stamp(t_s: float):
     """Seconds -> builtin_interfaces/Time."""
     from builtin_interfaces.msg import Time

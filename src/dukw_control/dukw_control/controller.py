@@ -69,6 +69,10 @@ NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
      1000.0),
     ('current.recover_rate_per_s', 'command scale regained per s below the ceiling', 0.001,
      100.0),
+    ('current.rest_below_scale', 'spent and derated below this scale: rest to cool (0: never)',
+     0.0, 0.99),
+    ('current.resume_fraction', 'a resting motor resumes at this share of the allowance',
+     0.0, 0.99),
     ('incline.sustained_time_s', 'beyond limits.incline_sustained_rad this long: stop climbing, s',
      0.0, 600.0),
     ('incline.release_margin_rad', 'the guard releases this far below the sustained limit, rad',
@@ -151,7 +155,8 @@ def settings_from_params(p: Mapping[str, ParamValue]) -> ControllerSettings:
                                    f('current.allowance_a2s'),
                                    f('current.derate_start_fraction'),
                                    f('current.derate_gain_per_s'),
-                                   f('current.recover_rate_per_s'))
+                                   f('current.recover_rate_per_s'),
+                                   f('current.rest_below_scale'), f('current.resume_fraction'))
     fields = ControllerSettings.__dataclass_fields__
     scalars = {name.replace('.', '_'): f(name) for name, *_ in NODE_PARAMS
                if name.replace('.', '_') in fields and name != 'closed_loop'}
@@ -194,6 +199,7 @@ class _Inputs:
     odom: tuple[float, float] = (0.0, 0.0)
     stamps: dict[str, float] = field(default_factory=dict)
     slips: tuple[float, float] = (0.0, 0.0)
+    weight_on_tracks_fraction: float = 0.0   # estimator: 0 afloat .. 1 dry (traction)
     incline_rad: float = 0.0
     rejected: int = 0
     last_rejection: str = ''
@@ -313,10 +319,14 @@ class DriveController:
         self.current['stbd'].update(stbd_a, dt)
         self.i.stamps['tracks/status'] = now_s
 
-    def on_slips(self, port_slip: float, stbd_slip: float, now_s: float) -> None:
-        """Track slips from the estimator (traction)."""
-        if math.isfinite(port_slip) and math.isfinite(stbd_slip):
+    def on_traction(self, port_slip: float, stbd_slip: float,
+                    weight_on_tracks_fraction: float, now_s: float) -> None:
+        """Track slips and the share of the weight on the tracks, from the estimator
+        (traction); a message with a non-finite value changes nothing."""
+        if math.isfinite(port_slip) and math.isfinite(stbd_slip) \
+                and math.isfinite(weight_on_tracks_fraction):
             self.i.slips = (port_slip, stbd_slip)
+            self.i.weight_on_tracks_fraction = min(max(weight_on_tracks_fraction, 0.0), 1.0)
             self.i.stamps['traction'] = now_s
 
     # --- the cycle --------------------------------------------------------------------
@@ -412,7 +422,7 @@ class DriveController:
                                               main[0] or derated, main[0] or derated)
             yaw_cmd += self.yaw_pi.update(yaw_sp - i.odom[1], dt, main[1], main[1])
         land = s.land.mix(speed_cmd, yaw_cmd)
-        water = s.water.mix(speed_cmd, yaw_cmd)
+        water = s.water.mix(speed_cmd, yaw_cmd, self._prop_moment_share(track_w, now_s))
         heavier = land if track_w >= prop_w else water
         self._last_mix_flags = (heavier.speed_saturated, heavier.yaw_saturated)
         tracks = land.sides.scaled(track_w)
@@ -427,6 +437,21 @@ class DriveController:
                               tracks.stbd * self.current['stbd'].scale)
         self.output = ControlOutput(tracks.scaled(fade), props.scaled(fade))
         return self.output
+
+    def _prop_moment_share(self, track_w: float, now_s: float) -> float:
+        """The part of their afloat yaw moment the propellers give: the water's share of the
+        weight while the tracks are used (1 afloat or on the propellers alone).
+
+        Grounded, the tracks' skid steer turns the vehicle; the propellers' largest moment
+        (~90 N m) is small against the tracks' lateral resistance, and at full differential
+        their thrusts cancel, thrust that the tracks need to climb out of the swash
+        (README "Main job"). A stale estimate counts as all the weight on the tracks.
+        """
+        if track_w == 0.0:
+            return 1.0
+        fresh = self._age('traction', now_s) <= self.s.traction_timeout_s
+        on_tracks = self.i.weight_on_tracks_fraction if fresh else 1.0
+        return 1.0 - track_w * on_tracks
 
     def _use_gains(self, gains: PiGains | None) -> None:
         """PI gains of the medium that carries the vehicle (None: the land / hand ones)."""

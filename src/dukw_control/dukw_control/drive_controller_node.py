@@ -94,7 +94,8 @@ class DriveControllerNode(Node):
         self.publish(self.runner.tick(self.now_s()))
 
     def on_traction(self, msg: Traction) -> None:
-        self.runner.on_traction(msg.port_slip, msg.stbd_slip, self.now_s())
+        self.runner.on_traction(msg.port_slip, msg.stbd_slip, msg.weight_on_tracks_fraction,
+                                self.now_s())
 
     def on_tracks(self, msg: DrivetrainStatus) -> None:
         self.runner.on_track_status(msg.connected, msg.port.current_a, msg.stbd.current_a,

@@ -74,6 +74,7 @@ class CurrentState(Enum):
     OVERLOAD = 'overload, using the allowance'
     DERATING = 'derating'
     SPENT = 'allowance spent: held at the continuous limit'
+    RESTING = 'allowance spent and derated: tracks stopped until the motor cools'
 
 
 @dataclass(frozen=True)
@@ -86,6 +87,8 @@ class CurrentLimitSettings:
     derate_start_fraction: float   # the ceiling starts falling at this share of the allowance
     derate_gain_per_s: float       # command scale lost per second per unit relative overcurrent
     recover_rate_per_s: float      # command scale regained per second below the ceiling
+    rest_below_scale: float = 0.0  # spent and derated below this: stop and cool (0: never)
+    resume_fraction: float = 0.3   # ... until the account is back to this share of it
 
     def __post_init__(self) -> None:
         if not 0 < self.continuous_a <= self.peak_a:
@@ -96,6 +99,8 @@ class CurrentLimitSettings:
             raise ValueError('derate_start_fraction must lie in [0, 1)')
         if not (self.derate_gain_per_s > 0 and self.recover_rate_per_s > 0):
             raise ValueError('derate gain and recover rate must be > 0')
+        if not (0.0 <= self.rest_below_scale < 1.0 and 0.0 <= self.resume_fraction < 1.0):
+            raise ValueError('rest_below_scale and resume_fraction must lie in [0, 1)')
 
 
 class CurrentLimiter:
@@ -106,6 +111,13 @@ class CurrentLimiter:
     the allowance is used, then falls linearly to ``continuous_a`` when it is spent,
     so a spent motor runs at or under its continuous rating. Whenever the measured
     current exceeds the ceiling the command scale falls; it recovers slowly below it.
+
+    Spent and derated below ``rest_below_scale``, the motor rests (scale 0) until the
+    account has cooled to ``resume_fraction`` of the allowance, then gets the full command
+    back. A track spinning at full slip draws the soil's shear strength whatever its speed
+    command (vehicle.md 6: H at |i| -> 1), so derating it further would not lower its
+    current, only slow the belt below the waves' uprush, which it then brakes (README
+    "Main job"): short bursts with rests keep the same I2t account and let it move.
     """
 
     def __init__(self, settings: CurrentLimitSettings) -> None:
@@ -113,6 +125,7 @@ class CurrentLimiter:
         self.heat_a2s = 0.0
         self.scale = 1.0
         self.current_a = 0.0
+        self.resting = False
 
     @property
     def used_fraction(self) -> float:
@@ -129,7 +142,9 @@ class CurrentLimiter:
 
     @property
     def state(self) -> CurrentState:
-        """OK, using the allowance, derating, or spent."""
+        """OK, using the allowance, derating, spent, or resting."""
+        if self.resting:
+            return CurrentState.RESTING
         if self.used_fraction >= 1.0:
             return CurrentState.SPENT
         if self.scale < 1.0:
@@ -146,6 +161,9 @@ class CurrentLimiter:
         self.current_a = abs(current_a)
         self.heat_a2s = max(self.heat_a2s + (self.current_a ** 2 - s.continuous_a ** 2) * dt,
                             0.0)
+        if self.resting:
+            self._rest()
+            return self.scale
         ceiling = self.ceiling_a
         excess = (self.current_a - ceiling) / ceiling
         if excess > 0.0:
@@ -153,4 +171,11 @@ class CurrentLimiter:
         else:
             self.scale += min(s.recover_rate_per_s, s.derate_gain_per_s * -excess) * dt
         self.scale = min(max(self.scale, 0.0), 1.0)
+        if self.used_fraction >= 1.0 and self.scale < s.rest_below_scale:
+            self.resting, self.scale = True, 0.0
         return self.scale
+
+    def _rest(self) -> None:
+        """Resting: full command back once the account has cooled enough."""
+        if self.used_fraction <= self.s.resume_fraction:
+            self.resting, self.scale = False, 1.0

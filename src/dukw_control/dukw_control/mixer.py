@@ -130,14 +130,19 @@ class WaterMixer:
         limit = self.max_thrust_n * (1.0 if pct >= 0 else self.reverse_thrust_ratio)
         return math.copysign(limit * min(abs(pct) / 100.0, 1.0) ** self.thrust_exponent, pct)
 
-    def mix(self, speed_mps: float, yaw_rate_rps: float) -> Mix:
-        """Propeller commands for (v, w) with yaw priority on the thrust limits."""
+    def mix(self, speed_mps: float, yaw_rate_rps: float, moment_share: float = 1.0) -> Mix:
+        """Propeller commands for (v, w) with yaw priority on the thrust limits.
+
+        ``moment_share`` (0..1): the part of the afloat yaw moment the propellers give (the
+        controller's share while the tracks carry weight and turn the vehicle)."""
         t_fwd = self.max_thrust_n
         t_rev = self.max_thrust_n * self.reverse_thrust_ratio
         force_n = math.copysign(2.0 * t_fwd * (speed_mps / self.max_speed_mps) ** 2, speed_mps)
         full_moment = (t_fwd + t_rev) * self.prop_arm_m
         moment_nm = math.copysign(
             full_moment * (yaw_rate_rps / self.yaw_rate_at_full_moment_rps) ** 2, yaw_rate_rps)
+        if moment_share != 1.0:
+            moment_nm *= min(max(moment_share, 0.0), 1.0)
         common, diff = force_n / 2.0, moment_nm / (2.0 * self.prop_arm_m)
         c, d, speed_sat, yaw_sat = saturate_yaw_priority(common, diff, -t_rev, t_fwd)
         return Mix(SidePair(self.thrust_to_pct(c - d), self.thrust_to_pct(c + d)),

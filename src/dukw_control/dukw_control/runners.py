@@ -138,8 +138,9 @@ class DriveControllerRunner:
     def on_imu(self, stamp_s: float, now_s: float) -> None:
         self.core.on_attitude(stamp_s, now_s)
 
-    def on_traction(self, port_slip: float, stbd_slip: float, now_s: float) -> None:
-        self.core.on_slips(port_slip, stbd_slip, now_s)
+    def on_traction(self, port_slip: float, stbd_slip: float,
+                    weight_on_tracks_fraction: float, now_s: float) -> None:
+        self.core.on_traction(port_slip, stbd_slip, weight_on_tracks_fraction, now_s)
 
     def on_track_status(self, connected: bool, port_a: float, stbd_a: float,
                         now_s: float) -> None:

@@ -26,6 +26,7 @@ class Rig:
         self.pitch_rad = 0.0
         self.imu_alive = True
         self.odom = None
+        self.weight_on_tracks = 1.0
 
     def run(self, seconds, cmd=(1.0, 0.0), send_cmd=True):
         out = None
@@ -37,7 +38,7 @@ class Rig:
             self.c.on_pitch(self.pitch_rad, self.t)
             if self.imu_alive:
                 self.c.on_attitude(self.t, self.t)
-            self.c.on_slips(0.1, 0.1, self.t)
+            self.c.on_traction(0.1, 0.1, self.weight_on_tracks, self.t)
             if self.odom is not None:
                 self.c.on_odometry(*self.odom, self.t)
             out = self.c.step(self.t)
@@ -152,6 +153,35 @@ def test_transition_blends_and_mode_changes_ramp(controller_settings):
     assert out.props.stbd == pytest.approx(full_props)
 
 
+@pytest.mark.parametrize('weight_on_tracks', [1.0, 0.9])
+def test_grounded_in_the_transition_the_props_push_and_the_tracks_steer(controller_settings,
+                                                                        weight_on_tracks):
+    open_loop = dataclasses.replace(controller_settings, closed_loop=False)
+    afloat = Rig(open_loop, mode=WATER).run(5.0, cmd=(0.8, 0.1))
+    steer = afloat.props.stbd - (afloat.props.port - 4.0)      # less the 4 % port bias
+    assert steer > 20.0                                        # afloat the props steer
+    r = Rig(open_loop, mode=TRANSITION)
+    r.weight_on_tracks = weight_on_tracks
+    out = r.run(5.0, cmd=(0.8, 0.1))
+    assert out.tracks.stbd - out.tracks.port > 5.0             # the tracks turn it ...
+    pushing = 100.0 * (0.8 / 1.2) ** 2                         # ... the props push
+    assert min(out.props.port, out.props.stbd) > 0.75 * pushing
+    grounded_steer = out.props.stbd - (out.props.port - 4.0)
+    assert -1e-9 <= grounded_steer <= (1.0 - weight_on_tracks) * steer + 1e-9
+
+
+def test_a_stale_traction_estimate_counts_as_all_weight_on_the_tracks(controller_settings):
+    r = Rig(dataclasses.replace(controller_settings, closed_loop=False), mode=TRANSITION)
+    r.weight_on_tracks = 0.0
+    out = r.run(2.0, cmd=(0.8, 0.1))
+    assert out.props.stbd - (out.props.port - 4.0) > 20.0      # as afloat
+    r.c.on_traction(0.1, 0.1, math.nan, r.t)                   # refused: changes nothing
+    assert r.c.i.weight_on_tracks_fraction == 0.0
+    r.c.i.stamps['traction'] = r.t - 10.0                      # the estimator fell silent
+    out = r.c._mix(0.8, 0.1, 1.0, DT, r.t)
+    assert out.props.stbd - (out.props.port - 4.0) == pytest.approx(0.0, abs=1e-9)
+
+
 def test_safe_stop_mode_is_neutral(controller_settings):
     r = Rig(controller_settings)
     r.run(2.0)
@@ -248,7 +278,7 @@ def test_stuck_stops_and_reports_until_a_stop_or_reversal(controller_settings):
         r.c.on_track_currents(20, 20, r.t)
         r.c.on_pitch(0, r.t)
         r.c.on_attitude(r.t, r.t)
-        r.c.on_slips(1.0, 1.0, r.t)
+        r.c.on_traction(1.0, 1.0, 1.0, r.t)
         r.c.on_odometry(0.0, 0.0, r.t)
         out = r.c.step(r.t)
     assert out.tracks.is_neutral() and out.neutral_reason.startswith('stuck')

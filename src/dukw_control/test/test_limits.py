@@ -1,4 +1,5 @@
 """Validation, rate limiter, PI anti-windup, I2t current limiter."""
+import dataclasses
 import math
 
 import pytest
@@ -64,8 +65,42 @@ def test_current_limiter_cools_and_recovers():
     assert lim.heat_a2s == 0.0 and lim.scale == 1.0 and lim.state == CurrentState.OK
 
 
+def test_a_spent_motor_held_at_its_limit_whatever_the_command_rests_then_gets_it_back():
+    # a track at full slip: the soil's shear strength sets the current (50 A) at any
+    # command above zero, so derating lowers only the belt speed; the limiter rests instead
+    lim = CurrentLimiter(dataclasses.replace(CURRENT, rest_below_scale=0.5,
+                                             resume_fraction=0.3))
+    scales, currents, states = [], [], set()
+    for _ in range(120 * 100):
+        current = 50.0 if lim.scale > 0.0 else 0.0
+        lim.update(current, 0.01)
+        scales.append(lim.scale)
+        currents.append(current)
+        states.add(lim.state)
+        assert lim.used_fraction < 1.1                # the account is kept
+    assert CurrentState.RESTING in states
+    rest = scales.index(0.0)
+    back = scales.index(1.0, rest)                    # full command again after the rest
+    assert lim.heat_a2s <= 15000.0 or lim.resting
+    assert 0.0 < min(scales[:rest]) and min(scales[:rest]) < 0.5 + 0.05
+    assert back - rest > 5 * 100                      # cooled for seconds, not a flicker
+    tail = currents[-60 * 100:]
+    assert math.sqrt(sum(c * c for c in tail) / len(tail)) <= 35.0 + 1.0
+    assert max(scales[-60 * 100:]) == 1.0             # bursts keep coming
+
+
+def test_without_a_rest_scale_a_spent_motor_only_derates():
+    lim = CurrentLimiter(CURRENT)
+    for _ in range(60 * 100):
+        lim.update(50.0 if lim.scale > 0.0 else 0.0, 0.01)
+        assert lim.state != CurrentState.RESTING
+    assert lim.scale < 0.5
+
+
 def test_current_limiter_refuses_nan():
     with pytest.raises(ValueError):
         CurrentLimiter(CURRENT).update(math.nan, 0.01)
     with pytest.raises(ValueError):
         CurrentLimitSettings(40.0, 35.0, 1.0, 0.5, 1.0, 1.0)
+    with pytest.raises(ValueError):
+        CurrentLimitSettings(35.0, 58.0, 1.0, 0.5, 1.0, 1.0, rest_below_scale=1.0)

@@ -167,8 +167,13 @@ def test_bad_port_parameter_is_refused_with_its_name():
 
 def test_maestro_error_register_is_a_warning_on_diagnostics(graph, maestro):
     assert graph.spin_until(lambda: graph.holder_is(Authority.HOLDER_COMPUTER))
+    seen = len(graph.diag)
     with maestro.lock:
         maestro.errors = 1 << 5  # serial timeout: the Maestro went to its home positions
-    assert graph.spin_until(lambda: graph.level() == DiagnosticStatus.WARN
-                            and 'serial_timeout' in graph.status('maestro').message)
-    assert graph.value('maestro', 'device_errors') == 'serial_timeout'
+
+    def warned():                # the device clears its register when read: the WARN is in
+        return [s for array in graph.diag[seen:] for s in array.status   # one report, and
+                if s.name.endswith('maestro') and s.level == DiagnosticStatus.WARN  # a later
+                and 'serial_timeout' in s.message]                       # one may follow it
+    assert graph.spin_until(lambda: bool(warned()))
+    assert {kv.key: kv.value for kv in warned()[0].values}['device_errors'] == 'serial_timeout'

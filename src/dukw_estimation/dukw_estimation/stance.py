@@ -31,6 +31,8 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from math import isfinite
+from operator import truediv
 from dataclasses import dataclass
 
 from dukw_common.readings import ImuSample
@@ -73,6 +75,7 @@ class StanceDetector:
 
     def __init__(self, settings: StanceSettings) -> None:
         self.settings = settings
+        self._sigmas_of: tuple[tuple, tuple[float, ...]] = ((), ())   # (variances, sigmas)
         self.reset()
 
     def reset(self) -> None:
@@ -95,12 +98,13 @@ class StanceDetector:
         st = self.settings
         values = (s.accel_x_mps2, s.accel_y_mps2, s.accel_z_mps2, s.roll_rate_rps,
                   s.pitch_rate_rps, s.yaw_rate_rps)
-        finite = all(math.isfinite(v) for v in (s.t_s, *values, *accel_mps2))
+        finite = (isfinite(s.t_s) and all(map(isfinite, values))
+                  and isfinite(accel_mps2[0]) and isfinite(accel_mps2[1]))
         if not finite or s.t_s <= self._last_t or s.t_s - self._last_t > 0.5 * st.window_s:
             self.reset()
             if not finite:
                 return False
-        z = tuple(v / sigma for v, sigma in zip(values, self._sigmas(s), strict=True))
+        z = tuple(map(truediv, values, self._sigmas(s)))      # (six of each)
         if math.isnan(self._since_t):
             self._since_t = s.t_s
         self._last_t = s.t_s
@@ -131,7 +135,15 @@ class StanceDetector:
         return self._decide(n)
 
     def _sigmas(self, s: ImuSample) -> tuple[float, ...]:
-        """The six channels' noise: the sample's own variances, else the settings'."""
+        """The six channels' noise: the sample's own variances, else the settings' (the
+        last sample's, when it gave the same variances: an IMU's rarely change)."""
+        key = (s.accel_var_m2ps4, s.roll_rate_var_rps2, s.pitch_rate_var_rps2,
+               s.yaw_rate_var_rps2)
+        if key != self._sigmas_of[0]:
+            self._sigmas_of = (key, self._noise(s))
+        return self._sigmas_of[1]
+
+    def _noise(self, s: ImuSample) -> tuple[float, ...]:
         st = self.settings
         ax_var, ay_var, az_var = s.accel_var_m2ps4
         return (_sigma(ax_var, st.accel_sigma_mps2), _sigma(ay_var, st.accel_sigma_mps2),

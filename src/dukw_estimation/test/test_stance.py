@@ -73,3 +73,21 @@ def test_bad_settings_are_refused(bad):
     values.update(bad)
     with pytest.raises(ValueError, match=next(iter(bad))):
         StanceSettings(**values)
+
+
+def test_the_noise_follows_the_samples_own_variances_when_they_change():
+    """The six sigmas are kept while the samples' variances stay; once an IMU reports four
+    times the variance, the same motion counts a quarter as much."""
+    changing, reference = StanceDetector(SETTINGS), StanceDetector(SETTINGS)
+    rng = np.random.default_rng(3)
+    for k in range(1, 201):
+        t, noise = k * 0.01, rng.normal(0.0, 0.01, 6)
+        values = (t, 0.0, 0.0, 0.0, *(0.003 / 0.01 * noise[:3]), *noise[3:5], G + noise[5])
+        variances = [math.nan] * 6 + [(1e-4,) * 3]
+        if k > 100:                     # from here on 4x the default variances, all six
+            variances = [math.nan, 3.6e-5, math.nan, math.nan, 3.6e-5, 3.6e-5, (4e-4,) * 3]
+        changing.add(ImuSample(*values, *variances), (noise[3], noise[4]))
+        if k > 100:
+            reference.add(ImuSample(*values, *variances), (noise[3], noise[4]))
+    assert reference.statistic == pytest.approx(changing.statistic, rel=1e-9)
+    assert changing.statistic == pytest.approx(0.25, rel=0.5)

@@ -17,7 +17,6 @@ ENU. Errors of the IMU's attitude and of the DGPS position drift slowly
 from __future__ import annotations
 
 import math
-import dataclasses
 from dataclasses import dataclass
 from enum import IntFlag
 from typing import Mapping
@@ -27,7 +26,7 @@ import numpy as np
 from dukw_common.config import ConfigError, ParamValue, build_settings, node_params, require
 from dukw_common.geometry import geodetic_from_local_enu
 from dukw_common.readings import (DepthReading, DriveStatus, GpsFix, GpsVelocity, ImuSample,
-                                  MotorSide, WaterContact)
+                                  MotorSide, WaterContact, positional_builder)
 from dukw_common.vehicle import (DrivetrainParams, SensorMounts, drivetrain_params,
                                   sensor_mounts)
 from dukw_model.lever_arm import (sensor_point_enu, sensor_point_velocity_body,
@@ -208,26 +207,6 @@ def _positive(params: Mapping[str, ParamValue], name: str) -> float:
     if value <= 0:
         raise ConfigError(f'parameter {name!r} must be > 0, got {value}')
     return value
-
-
-def positional_builder(cls: type):
-    """A function building ``cls`` (a frozen, slotted dataclass) from all its fields given
-    positionally, about 4x cheaper than its __init__ (which sets each field through
-    object.__setattr__): an unfrozen slotted twin with the same fields (so the same slot
-    layout) is built and takes ``cls`` as its class. The result is an ordinary ``cls``:
-    equal to ``cls(*values)``, frozen, hashable. No defaults and no __post_init__ checks:
-    for the sensor models' own readings, whose values are floats they computed."""
-    if not dataclasses.is_dataclass(cls) or '__slots__' not in vars(cls):
-        raise TypeError(f'{cls.__name__} is not a slotted dataclass')
-    twin = dataclasses.make_dataclass(
-        f'_{cls.__name__}Fields', [(f.name, f.type) for f in dataclasses.fields(cls)],
-        slots=True)
-
-    def build(*values):
-        obj = twin(*values)
-        obj.__class__ = cls
-        return obj
-    return build
 
 
 _imu_sample = positional_builder(ImuSample)
