@@ -4,7 +4,7 @@ ROS-free. The motion filter (``motion_filter.MotionFilter``) estimates where the
 and the water surface are; this model turns that into what the hulls displace and what the
 sand carries (vehicle.md 6), and decides afloat / on the sand from the IMU's motion test,
 the track forces and the geometry. Its state (the decision, the weight share, the IMU's
-motion and heave filters, the smoothed track forces, the beach slope) changes only when
+motion filter, the smoothed track forces, the beach slope) changes only when
 a sample arrives or the filter advances (``Estimator``), never when someone asks.
 """
 from __future__ import annotations
@@ -21,7 +21,6 @@ from dukw_estimation.force_filter import ForceSmoother
 from dukw_common.readings import DriveStatus, ImuSample
 from dukw_estimation.settings import EkfSettings
 
-MAX_IMU_STEP_S = 0.1             # IMU gaps longer than this do not feed the heave integral
 SLOPE_FRACTION = 0.9             # above this share the pitch is the beach's, not the waves'
 TOUCHDOWN_SHARE = 0.8           # afloat until the mean-surface volume drops below this share
 #: hull volumes remembered by their inputs (one sample asks for the same volume several
@@ -82,30 +81,16 @@ class ContactModel:
         self.fraction = 1.0
         self.afloat = False
         self.motion_level = 0.0          # > 1: rolling, pitching, heaving like a floating hull
-        self._heave_mean_mps2 = 0.0      # slow mean of the heave acceleration (tilt, bias)
-        self.heave_velocity_mps = 0.0
         self.force = [ForceSmoother(st.force_process_n_per_s, st.force_measurement_n)
                       for _ in range(2)]
         # per track: ((status, smoothed force), its soil force) last worked out
         self._soil_forces: list[tuple[tuple, float]] = [((None, math.nan), math.nan)] * 2
 
     # ------------------------------------------------------------------ IMU
-    def heave_accel_mps2(self, imu: ImuSample | None,
-                         accel_base: tuple[float, float, float]) -> float:
-        """Vertical acceleration of base_link: the IMU's specific force over the tilt, less
-        g (NaN without an IMU sample)."""
-        fz = accel_base[2]
-        if imu is None or not math.isfinite(fz):
-            return math.nan
-        tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
-        return fz / max(tilt, 0.5) - self.vehicle.body.gravity_mps2
-
-    def observe_imu(self, s: ImuSample, accel_base: tuple[float, float, float],
-                    dt: float) -> None:
-        """The motion test's low-pass and the heave velocity, from one IMU sample."""
-        heave = self.heave_accel_mps2(s, accel_base)
-        self._update_motion(s, heave, dt)
-        self._update_heave_velocity(heave, dt)
+    def observe_imu(self, s: ImuSample, heave_accel_mps2: float, dt: float) -> None:
+        """The motion test's low-pass, from one IMU sample and base_link's vertical
+        acceleration (``MotionFilter.heave_accel_mps2``)."""
+        self._update_motion(s, heave_accel_mps2, dt)
 
     def _update_motion(self, s: ImuSample, heave: float, dt: float) -> None:
         """Low-pass of (roll/pitch rate, heave acceleration) over their thresholds, squared."""
@@ -115,16 +100,6 @@ class ContactModel:
                  + heave ** 2 / st.contact_accel_mps2 ** 2)
         alpha = min(dt / st.contact_time_constant_s, 1.0) if dt > 0.0 else 1.0
         self.motion_level += alpha * (level - self.motion_level)
-
-    def _update_heave_velocity(self, accel: float, dt: float) -> None:
-        """Heave velocity from the heave acceleration: its slow mean (attitude error, bias)
-        removed, then a leaky integral (heave.velocity_time_constant_s)."""
-        if not math.isfinite(accel) or not 0.0 < dt <= MAX_IMU_STEP_S:
-            return
-        tau = self.settings.heave_velocity_tau_s
-        self._heave_mean_mps2 += min(dt / (4.0 * tau), 1.0) * (accel - self._heave_mean_mps2)
-        self.heave_velocity_mps += dt * (accel - self._heave_mean_mps2) \
-            - min(dt / tau, 1.0) * self.heave_velocity_mps
 
     def update_slope(self, s: ImuSample, yaw_rad: float, dt: float) -> None:
         """Low-pass the beach slope along the seaward direction from pitch and roll."""
@@ -280,13 +255,15 @@ class ContactModel:
         self.afloat = self.floating(grounded, imu_fresh, pushing)
         self.fraction = self.fraction_of(self.weight_n(grounded, self.afloat))
 
-    def afloat_volume_m3(self, heave_accel_mps2: float, imu_fresh: bool) -> float:
-        """Floating: the displacement, plus what the heave acceleration says (IMU fresh)."""
+    def afloat_volume_m3(self, heave_accel_mps2: float, heave_rate_mps: float,
+                         imu_fresh: bool) -> float:
+        """Floating: the displacement, plus what the heave acceleration and the damping force
+        of the heave rate say (IMU fresh)."""
         body = self.vehicle.body
         if not math.isfinite(heave_accel_mps2) or not imu_fresh:
             return body.displaced_volume_m3
         volume = buoyancy.afloat_dynamic_volume_m3(
-            body.displacement_n + self.heave_damping_n_per_mps * self.heave_velocity_mps,
+            body.displacement_n + self.heave_damping_n_per_mps * heave_rate_mps,
             self.heave_mass_kg, heave_accel_mps2, body.water_density_kgpm3, body.gravity_mps2)
         return min(max(volume, 0.0), self.max_volume_m3)
 

@@ -1,5 +1,5 @@
-"""The motion filter: a 15-state EKF in the plane, with the waterline distance, the wave, the
-soil's strength and the accelerometers' gravity leak.
+"""The motion filter: a 17-state EKF in the plane, with the waterline distance, the wave, the
+soil's strength, the accelerometers' gravity leak and the hull's heave.
 
 State (``Idx``): odom position x, y; yaw; body surge u, sway v; yaw rate r; gyro-z bias;
 waterline distance s (along the slope, base_link seaward of the mean waterline); wave
@@ -12,7 +12,11 @@ zero-mean oscillation about the surveyed waterline, the soil lasts (issue 18); a
 surge and sway accelerations' slow error (first-order Gauss-Markov): gravity leaking through
 the IMU's attitude error (0.2 deg x g = 0.034 m/s^2 for ~10 s), which the velocity would
 otherwise integrate into a ground-speed bias of a few cm/s (issue 18: the slip at low belt
-speeds).
+speeds); and the height of base_link (the keel, the tracks' bottom) above the mean water level
+and its rate, driven by the IMU's vertical acceleration: on the sand it is the beach's height
+under base_link, afloat the keel sits under the wave by the draft the hull's heave dynamics
+give, so the heave carries the wave from the sand into the water and back (issue 18: the
+surface at a touchdown in the surf).
 
 Predict and update are the compiled kernels of ``ekf_kernels`` rather than filterpy's
 generic ``ExtendedKalmanFilter``: its update cannot gate an innovation before applying it
@@ -44,6 +48,14 @@ WATER_SURFACE_STATES = np.array([1.0 if i in (Idx.S, Idx.ETA, Idx.ETA_RATE) else
                                  for i in Idx])
 #: A sounding afloat mixes the wave with the vehicle's heave: it may correct s only.
 WATERLINE_STATE = np.array([1.0 if i == Idx.S else 0.0 for i in Idx])
+#: ``heave.HeaveObserver``'s measurements: afloat the keel under the wave by the dynamic
+#: draft moves the wave and the heave; the keel on the beach at a touchdown moves them and
+#: the waterline distance (``HEAVE_SURFACE_STATES``), on the sand after it the heave only.
+HEAVE_SURFACE_STATES = np.array([1.0 if i in (Idx.S, Idx.ETA, Idx.ETA_RATE, Idx.HEAVE,
+                                              Idx.HEAVE_RATE) else 0.0 for i in Idx])
+WAVE_HEAVE_STATES = np.array([1.0 if i in (Idx.ETA, Idx.ETA_RATE, Idx.HEAVE, Idx.HEAVE_RATE)
+                              else 0.0 for i in Idx])
+HEAVE_STATES = np.array([1.0 if i in (Idx.HEAVE, Idx.HEAVE_RATE) else 0.0 for i in Idx])
 #: ``update_scalar`` without a mask (the kernel's argument when ``only`` is None)
 _NO_MASK = np.ones(N_STATES)
 
@@ -76,6 +88,7 @@ class ProcessNoise:
     soil_scale_per_sqrt_s: float = 0.0
     accel_bias_sigma_mps2: float = 0.0
     accel_bias_tau_s: float = 1.0
+    heave_accel_mps2: float = 0.0
 
     def wave_drive(self) -> float:
         """Spectral density driving the oscillator so that its stationary sigma is wave_sigma."""
@@ -104,12 +117,15 @@ class MotionEkf:
 
     def predict(self, dt: float, accel_body: tuple[float, float] | None = None,
                 drive_target: tuple[float, float, float] | None = None,
-                accel_noise_mps2: float | None = None, slope_rad: float = 0.0) -> None:
+                accel_noise_mps2: float | None = None, slope_rad: float = 0.0,
+                heave_accel_mps2: float = math.nan) -> None:
         """Advance by ``dt`` s.
 
         ``accel_body``: (du/dt, dv/dt) from the IMU (gravity and centripetal removed) as
         input. Else ``drive_target`` (u, r, time constant) pulls u and r towards what the
         tracks or propellers command; else u, v, r are held (random walk).
+        ``heave_accel_mps2``: base_link's vertical acceleration, the heave rate's input
+        (NaN: the heave rate held).
         """
         if dt <= 0.0:
             return
@@ -126,7 +142,7 @@ class MotionEkf:
         kernels.predict(self.x, self.P, q_rate, dt, mode, float(inputs[0]), float(inputs[1]),
                         float(inputs[2]), self.seaward_yaw_rad, 1.0 / math.cos(slope_rad),
                         self._wave_omega_rps, self._wave_damping, self._gps_bias_tau_s,
-                        self._accel_bias_tau_s)
+                        self._accel_bias_tau_s, float(heave_accel_mps2))
 
     def _q_rate(self, accel_mps2: float) -> np.ndarray:
         """The diagonal of the process noise per second with this acceleration noise."""
@@ -136,7 +152,8 @@ class MotionEkf:
         return np.array([n.position_m ** 2, n.position_m ** 2, n.yaw_rad ** 2, accel_mps2 ** 2,
                          accel_mps2 ** 2, n.yaw_accel_rps2 ** 2, n.gyro_bias_rps ** 2,
                          n.waterline_m ** 2, 0.0, n.wave_drive(), bias_q, bias_q,
-                         n.soil_scale_per_sqrt_s ** 2, accel_q, accel_q])
+                         n.soil_scale_per_sqrt_s ** 2, accel_q, accel_q, 0.0,
+                         n.heave_accel_mps2 ** 2])
 
     def update(self, z: np.ndarray, hx: np.ndarray, H: np.ndarray, R: np.ndarray,
                gate: float, angle_rows: tuple[int, ...] = ()) -> Outcome:

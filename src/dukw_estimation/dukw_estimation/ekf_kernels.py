@@ -1,6 +1,6 @@
 """The motion EKF's numeric kernels, compiled with numba (``ekf.MotionEkf`` calls them).
 
-A 15-state prediction or scalar update is a few hundred floating-point operations; written
+A 17-state prediction or scalar update is a few hundred floating-point operations; written
 with numpy it was a dozen or more array calls of ~0.5-1 us each (the covariance's
 F P F^T, the gain, the rank-1 correction), most of an IMU step's cost (issue 16). Here each
 is one compiled call. ``cache=True`` keeps the machine code beside the module
@@ -26,6 +26,7 @@ _X, _Y, _YAW, _U, _V, _R = (int(Idx.X), int(Idx.Y), int(Idx.YAW), int(Idx.U), in
 _S, _ETA, _ETA_RATE, _GBE, _GBN = (int(Idx.S), int(Idx.ETA), int(Idx.ETA_RATE),
                                    int(Idx.GPS_BIAS_E), int(Idx.GPS_BIAS_N))
 _ABX, _ABY = int(Idx.ACCEL_BIAS_X), int(Idx.ACCEL_BIAS_Y)
+_HZ, _HW = int(Idx.HEAVE), int(Idx.HEAVE_RATE)
 #: ``predict``'s input modes: held, the IMU's accelerations, the drive model's target
 HOLD, ACCEL, DRIVE = 0, 1, 2
 
@@ -40,11 +41,12 @@ def wrap_angle(angle_rad: float) -> float:
 def predict(x: np.ndarray, P: np.ndarray, q_rate: np.ndarray, dt: float, mode: int,
             in0: float, in1: float, in2: float, seaward_yaw_rad: float, inv_cos_slope: float,
             wave_omega_rps: float, wave_damping: float, gps_bias_tau_s: float,
-            accel_bias_tau_s: float) -> None:
+            accel_bias_tau_s: float, heave_accel: float) -> None:
     """``MotionEkf.predict`` in place: x advanced by ``dt``, P = F P F^T + diag(q_rate) dt.
 
     ``mode`` ACCEL: (in0, in1) the body accelerations; DRIVE: (in0, in1, in2) the target's
-    surge, yaw rate and time constant; HOLD: u, v, r held (random walk)."""
+    surge, yaw rate and time constant; HOLD: u, v, r held (random walk). ``heave_accel``:
+    base_link's vertical acceleration (the IMU's), the heave rate's input; NaN: held."""
     n = x.shape[0]
     yaw, u, v, r = x[_YAW], x[_U], x[_V], x[_R]
     eta, eta_rate, abx, aby = x[_ETA], x[_ETA_RATE], x[_ABX], x[_ABY]
@@ -96,6 +98,10 @@ def predict(x: np.ndarray, P: np.ndarray, q_rate: np.ndarray, dt: float, mode: i
     x[_ABY] = aby * leak
     F[_ABX, _ABX] = leak
     F[_ABY, _ABY] = leak
+    x[_HZ] += x[_HW] * dt
+    F[_HZ, _HW] = dt
+    if heave_accel == heave_accel:       # not NaN
+        x[_HW] += heave_accel * dt
     _propagate(F, P)
     for i in range(n):
         P[i, i] += q_rate[i] * dt
@@ -204,7 +210,7 @@ def warm(n_states: int = len(Idx)) -> None:
     first sample of a process does not (``make setup`` runs this once per build: the cache
     beside the module then serves every later process)."""
     x, P, ones = np.zeros(n_states), np.eye(n_states), np.ones(n_states)
-    predict(x, P, ones, 0.01, HOLD, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.1, 1.0, 1.0)
+    predict(x, P, ones, 0.01, HOLD, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.1, 1.0, 1.0, 0.0)
     h = np.zeros(n_states)
     h[_R] = 1.0
     update_scalar(x, P, 0.0, h, 1.0, math.inf, False, ones)

@@ -23,6 +23,8 @@ class Idx(IntEnum):
     SOIL = 12
     ACCEL_BIAS_X = 13
     ACCEL_BIAS_Y = 14
+    HEAVE = 15
+    HEAVE_RATE = 16
 
 
 N_STATES = len(Idx)

@@ -8,7 +8,8 @@ filter goes on predicting without it (robot_localization's behaviour).
 ``Estimator`` composes three parts: ``motion_filter.MotionFilter`` (the EKF, its
 prediction and the motion sensors), ``contact.ContactModel`` (afloat or on the sand,
 the hulls' volume, the weight on the tracks) and ``surface.SurfaceObserver`` (water
-contact, depth and track forces correcting the surface states); at rest on the sand
+contact, depth and track forces correcting the surface states) and ``heave.HeaveObserver``
+(the keel on the beach, or under the wave by the hull's dynamic draft); at rest on the sand
 (``stance.StanceDetector``) the ground velocity is measured as zero. The contact decision is
 refreshed after every admitted sample and ``advance``; ``odometry()`` and ``traction()``
 only read, so asking for the estimate twice (or never) changes nothing.
@@ -26,6 +27,7 @@ from dukw_common.readings import (DepthReading, DriveStatus, GpsFix, GpsVelocity
 from dukw_model import traction
 from dukw_estimation.contact import ContactModel, ground_speeds
 from dukw_estimation.ekf import Idx, MotionEkf, Outcome
+from dukw_estimation.heave import HeaveObserver
 from dukw_estimation.motion_filter import (GROUNDED_FRACTION, TRACK_ODOMETRY_MIN_BELT_MPS,
                                            MotionFilter)
 from dukw_estimation.samples import OdometryEstimate, TractionEstimate
@@ -39,6 +41,7 @@ from dukw_estimation.surface import SurfaceObserver
 _NO_PAIR = (math.nan, math.nan)
 # plain ints for the hot paths (indexing numpy with IntEnum members is slower)
 _YAW, _S, _ETA, _SOIL = int(Idx.YAW), int(Idx.S), int(Idx.ETA), int(Idx.SOIL)
+_HEAVE_RATE = int(Idx.HEAVE_RATE)
 
 
 class Estimator:
@@ -51,6 +54,7 @@ class Estimator:
         self.contact = ContactModel(vehicle, settings, soil)
         self.online_soil = OnlineSoil(soil, online_soil_settings(settings))
         self.surface = SurfaceObserver(vehicle, settings, self.contact)
+        self.heave = HeaveObserver(vehicle, settings, self.contact)
         self.stance = StanceDetector(stance_settings(settings))
         self.counters: dict[str, dict[Outcome, int]] = {s: defaultdict(int) for s in SENSORS}
         self.rates = {s: RateCounter() for s in SENSORS}
@@ -89,6 +93,7 @@ class Estimator:
         self.odometry_slips: tuple[float, float] | None = None
         self.contact.reset()
         self.surface.reset()
+        self.heave.reset()
         self.stance.reset()
         self.at_rest = False            # the last IMU sample's zero-velocity decision
         self.zero_velocity_updates = 0  # accepted since the reset
@@ -167,8 +172,12 @@ class Estimator:
         if rejected:
             return rejected
         out, dt = self.motion_filter.add_imu(s)
-        self.contact.observe_imu(s, self.motion_filter.accel_base, dt)
+        heave = self.motion_filter.heave_accel_mps2()
+        self.contact.observe_imu(s, heave, dt)
         self._refresh_contact()
+        if self.heave.update(self.ekf, heave, self.motion_filter.position_set) \
+                is Outcome.ACCEPTED:
+            self._refresh_contact()
         self.contact.update_slope(s, self.ekf.x[Idx.YAW], dt)
         self._zero_velocity(s)
         return self._count('imu', out)
@@ -321,8 +330,8 @@ class Estimator:
         h2, grounded = contact.submersion(x)
         afloat = contact.afloat
         if afloat:
-            heave = contact.heave_accel_mps2(motion.imu, motion.accel_base)
-            volume = contact.afloat_volume_m3(heave, motion.fresh_now('imu'))
+            volume = contact.afloat_volume_m3(motion.heave_accel_mps2(), x.item(_HEAVE_RATE),
+                                              motion.fresh_now('imu'))
         else:
             volume = min(grounded, contact.displaced_m3)   # on the sand: it does not float
         weight = contact.weight_n(grounded, afloat)

@@ -5,7 +5,8 @@ times, the GPS datum, and predicts the EKF forward: with the IMU's accelerations
 with the drive model (tracks when their share of the weight drives the vehicle, else the
 propellers). It corrects heading, yaw rate and gyro bias from the IMU, the position and
 velocity from the DGPS (antenna lever arm), GPS velocity stale on land, the speed
-from the tracks, and at rest the zero velocity (``zero_velocity``). The surface states'
+from the tracks, the heave rate from the DGPS's up velocity, and at rest the zero velocity
+(``zero_velocity``). The surface states'
 corrections live in ``surface.SurfaceObserver``.
 """
 from __future__ import annotations
@@ -19,7 +20,7 @@ from dukw_common.vehicle import Vehicle
 from dukw_model import traction
 from dukw_model.lever_arm import (base_from_sensor_point, lever_arm_enu,
                                   sensor_point_velocity_body, specific_force_at_base)
-from dukw_estimation.ekf import N_STATES, Idx, MotionEkf, Outcome, ProcessNoise
+from dukw_estimation.ekf import HEAVE_STATES, N_STATES, Idx, MotionEkf, Outcome, ProcessNoise
 from dukw_common.readings import DriveStatus, GpsFix, GpsVelocity, ImuSample
 from dukw_estimation.samples import OdometryEstimate
 from dukw_estimation.settings import SENSORS, EkfSettings
@@ -60,6 +61,11 @@ _H_U.flags.writeable = False
 _H_V = np.zeros(N_STATES)
 _H_V[_V] = 1.0
 _H_V.flags.writeable = False
+#: the GPS up velocity's row (read only): the heave rate
+_HEAVE_RATE = int(Idx.HEAVE_RATE)
+_H_HEAVE_RATE = np.zeros(N_STATES)
+_H_HEAVE_RATE[_HEAVE_RATE] = 1.0
+_H_HEAVE_RATE.flags.writeable = False
 
 class MotionFilter:
     """Pose, twist, gyro bias and GPS bias of base_link in odom (and the EKF's time)."""
@@ -79,14 +85,15 @@ class MotionFilter:
                        (st.wave_sigma_m * 2 * math.pi * st.wave_peak_frequency_hz) ** 2 + 1e-6,
                        st.gps_bias_sigma_m ** 2, st.gps_bias_sigma_m ** 2,
                        st.soil_scale_sigma ** 2, st.q_accel_bias_mps2 ** 2,
-                       st.q_accel_bias_mps2 ** 2])
+                       st.q_accel_bias_mps2 ** 2, st.init_heave_m ** 2,
+                       st.init_heave_rate_mps ** 2])
         noise = ProcessNoise(st.q_position_m, st.q_yaw_rad, st.q_accel_mps2, st.q_yaw_accel_rps2,
                              st.q_gyro_bias_rps, st.q_waterline_m,
                              2 * math.pi * st.wave_peak_frequency_hz, st.wave_damping_ratio,
                              st.wave_sigma_m, st.gps_bias_sigma_m, st.gps_bias_tau_s,
                              st.soil_scale_process_per_sqrt_s if st.soil_scale_sigma > 0.0
                              else 0.0,         # sigma 0: the soil trusted, the factor 1
-                             st.q_accel_bias_mps2, st.q_accel_bias_tau_s)
+                             st.q_accel_bias_mps2, st.q_accel_bias_tau_s, st.q_heave_accel_mps2)
         x0 = np.zeros(N_STATES)
         x0[Idx.SOIL] = 1.0               # the soil as the contact model knows it
         self.ekf = MotionEkf(x0, p0, noise, st.seaward_yaw_rad)
@@ -158,13 +165,24 @@ class MotionFilter:
         accel = None
         noise = None
         target = None
+        heave = math.nan
         if imu is not None and self.fresh('imu', now) and math.isfinite(self.accel_base[0]):
             ax, ay = self.gravity_free_accel()
             accel = (ax + x[Idx.R] * x[Idx.V], ay - x[Idx.R] * x[Idx.U])
+            heave = self.heave_accel_mps2()
         else:
             noise = st.q_accel_no_imu_mps2
             target = self._drive_target(now, fraction)
-        self.ekf.predict(dt, accel, target, noise, self.vehicle.site.beach_slope_rad)
+        self.ekf.predict(dt, accel, target, noise, self.vehicle.site.beach_slope_rad, heave)
+
+    def heave_accel_mps2(self) -> float:
+        """Vertical acceleration of base_link, m/s^2: the last IMU sample's specific force at
+        base_link over the tilt, less g (NaN without an IMU sample)."""
+        imu, fz = self.imu, self.accel_base[2]
+        if imu is None or not math.isfinite(fz):
+            return math.nan
+        tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
+        return fz / max(tilt, 0.5) - self.vehicle.body.gravity_mps2
 
     def gravity_free_accel(self) -> tuple[float, float]:
         """The last IMU sample's surge and sway acceleration at base_link, m/s^2, gravity
@@ -284,9 +302,21 @@ class MotionFilter:
         H[0, Idx.U], H[0, Idx.V], H[0, Idx.YAW] = c, -sn, -sn * ub - c * vb
         H[1, Idx.U], H[1, Idx.V], H[1, Idx.YAW] = sn, c, c * ub - sn * vb
         var = s.var_mps2 if s.var_mps2 > 0 else self.settings.gps_velocity_mps ** 2
-        return self.ekf.update(np.array([s.east_mps, s.north_mps]),
-                               np.array([c * ub - sn * vb, sn * ub + c * vb]), H,
-                               np.eye(2) * var, self.settings.gate_gps_vel)
+        out = self.ekf.update(np.array([s.east_mps, s.north_mps]),
+                              np.array([c * ub - sn * vb, sn * ub + c * vb]), H,
+                              np.eye(2) * var, self.settings.gate_gps_vel)
+        if math.isfinite(s.up_mps):
+            # the antenna's up velocity is base_link's heave rate (the mast's rotation moves
+            # it up only to second order in roll and pitch); it corrects the heave only: on the
+            # sand the keel's height is tied to the waterline distance through the estimated
+            # slope, which need not be the beach's
+            var = s.up_var_mps2 if s.up_var_mps2 > 0 else self.settings.gps_velocity_mps ** 2
+            up = self.ekf.update_scalar(s.up_mps, float(self.ekf.x[_HEAVE_RATE]),
+                                        _H_HEAVE_RATE, var, self.settings.gate_gps_vel,
+                                        only=HEAVE_STATES)
+            if out is Outcome.ACCEPTED:
+                out = up
+        return out
 
     # ------------------------------------------------------------------ tracks
     def track_odometry(self, s: DriveStatus, slips: tuple[float, float] | None) -> None:

@@ -107,9 +107,18 @@ class EkfSettings:
     heave_damping_ratio: float = _f('seakeeping.heave_damping_ratio',
                                     'heave damping ratio afloat (the damping force joins the '
                                     'heave acceleration in the afloat volume)', 0, 2)
-    heave_velocity_tau_s: float = _f('heave.velocity_time_constant_s', 'heave velocity: '
-                                     'leaky integral of the (mean-removed) heave '
-                                     'acceleration', 0.1, 100)
+    q_heave_accel_mps2: float = _f('heave.accel_noise_mps2', "heave rate's noise with the "
+                                   "IMU's vertical acceleration as input (per sqrt(s))",
+                                   1e-6, 100)
+    heave_surface_m: float = _f('heave.surface_sigma_m', 'afloat: the keel under the wave by '
+                                'the dynamic draft, sigma', 1e-4, 1)
+    heave_ground_m: float = _f('heave.ground_sigma_m', 'on the sand: the keel on the beach, '
+                               'sigma', 1e-4, 1)
+    heave_gate: float = _f('heave.mahalanobis', 'rejection distance of both', 0.5, 1e6)
+    init_heave_m: float = _f('initial_sigma.heave_m', "initial sigma of the keel's height",
+                             1e-4, 100)
+    init_heave_rate_mps: float = _f('initial_sigma.heave_rate_mps',
+                                    'initial heave-rate sigma', 1e-4, 100)
     contact_rate_rps: float = _f('contact.rate_threshold_rps', 'roll/pitch rate scale above '
                                  'which the hull is taken to float (grounded: ~0)', 1e-4, 10)
     contact_accel_mps2: float = _f('contact.accel_threshold_mps2',

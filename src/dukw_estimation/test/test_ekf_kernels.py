@@ -22,8 +22,9 @@ def random_filter(rng: np.random.Generator) -> MotionEkf:
     return ekf
 
 
-def reference_predict(x, P, dt, accel, target, slope_rad, q_diag):
-    """The numpy prediction the kernel replaced: F from the motion model, P = F P F^T + Q dt."""
+def reference_predict(x, P, dt, accel, target, slope_rad, q_diag, heave_accel=math.nan):
+    """The numpy prediction the kernel replaced: F from the motion model, P = F P F^T + Q dt
+    (and the heave: its height integrates its rate, the rate the vertical acceleration)."""
     x = x.copy()
     yaw, u, v, r = x[Idx.YAW], x[Idx.U], x[Idx.V], x[Idx.R]
     c, s = math.cos(yaw), math.sin(yaw)
@@ -60,6 +61,10 @@ def reference_predict(x, P, dt, accel, target, slope_rad, q_diag):
                  (Idx.ACCEL_BIAS_X, leak), (Idx.ACCEL_BIAS_Y, leak)):
         x[i] *= f
         F[i, i] = f
+    x[Idx.HEAVE] += x[Idx.HEAVE_RATE] * dt
+    F[Idx.HEAVE, Idx.HEAVE_RATE] = dt
+    if not math.isnan(heave_accel):
+        x[Idx.HEAVE_RATE] += heave_accel * dt
     return x, F @ P @ F.T + np.diag(q_diag) * dt
 
 
@@ -77,9 +82,10 @@ def test_prediction_is_the_numpy_form(inputs):
         target = (0.8, -0.1, 0.5) if inputs == 'target' else None
         noise = None if inputs == 'accel' else 0.7
         dt, slope = 0.013, 0.05
+        heave = rng.standard_normal() if inputs == 'accel' else math.nan
         x_ref, P_ref = reference_predict(ekf.x, ekf.P, dt, accel, target, slope,
-                                         ekf._q_rate(noise or NOISE.accel_mps2))
-        ekf.predict(dt, accel, target, noise, slope)
+                                         ekf._q_rate(noise or NOISE.accel_mps2), heave)
+        ekf.predict(dt, accel, target, noise, slope, heave)
         assert np.array_equal(ekf.x, x_ref)       # the state's arithmetic is the same
         assert_close(ekf.P, P_ref)
 
