@@ -68,7 +68,7 @@ def test_long_15_deg_slope_stops_climbing_and_reports_the_spent_allowance():
     assert c.current['port'].used_fraction >= 1.0
     assert c.current['port'].state in (CurrentState.SPENT, CurrentState.RESTING)
     messages = ' '.join(h.message for h in c.healths(loop.truth.t_s))
-    assert 'allowance spent' in messages and 'climbing stopped' in messages
+    assert 'motor resting' in messages and 'climbing stopped' in messages
     loop.run(3.0, cmd=(-0.5, 0.0))                   # driving down stays allowed
     assert loop.truth.surge_mps < -0.2
 

@@ -69,7 +69,7 @@ NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
      1000.0),
     ('current.recover_rate_per_s', 'command scale regained per s below the ceiling', 0.001,
      100.0),
-    ('current.rest_below_scale', 'spent and derated below this scale: rest to cool (0: never)',
+    ('current.rest_below_scale', 'derated below this scale: rest to cool (0: never)',
      0.0, 0.99),
     ('current.resume_fraction', 'a resting motor resumes at this share of the allowance',
      0.0, 0.99),
@@ -433,10 +433,15 @@ class DriveController:
         tracks = apply_port_bias(tracks, s.port_bias_land_pct, s.bias_full_above_pct)
         props = apply_port_bias(props, s.port_bias_water_pct, s.bias_full_above_pct)
         if not self._descending(speed_sp):
-            tracks = SidePair(tracks.port * self.current['port'].scale,
-                              tracks.stbd * self.current['stbd'].scale)
+            tracks = tracks.scaled(self._track_scale())
         self.output = ControlOutput(tracks.scaled(fade), props.scaled(fade))
         return self.output
+
+    def _track_scale(self) -> float:
+        """Both tracks' command scale: the hotter motor's. Scaled alike, a derated vehicle
+        slows along its path instead of turning toward the hotter side, and a resting motor
+        rests both (a burst on one track in the swash only slews the vehicle)."""
+        return min(self.current['port'].scale, self.current['stbd'].scale)
 
     def _prop_moment_share(self, track_w: float, now_s: float) -> float:
         """The part of their afloat yaw moment the propellers give: the water's share of the

@@ -74,7 +74,7 @@ class CurrentState(Enum):
     OVERLOAD = 'overload, using the allowance'
     DERATING = 'derating'
     SPENT = 'allowance spent: held at the continuous limit'
-    RESTING = 'allowance spent and derated: tracks stopped until the motor cools'
+    RESTING = 'resting: tracks stopped until the motor cools'
 
 
 @dataclass(frozen=True)
@@ -87,7 +87,7 @@ class CurrentLimitSettings:
     derate_start_fraction: float   # the ceiling starts falling at this share of the allowance
     derate_gain_per_s: float       # command scale lost per second per unit relative overcurrent
     recover_rate_per_s: float      # command scale regained per second below the ceiling
-    rest_below_scale: float = 0.0  # spent and derated below this: stop and cool (0: never)
+    rest_below_scale: float = 0.0  # derated below this: stop and cool (0: never) ...
     resume_fraction: float = 0.3   # ... until the account is back to this share of it
 
     def __post_init__(self) -> None:
@@ -112,9 +112,9 @@ class CurrentLimiter:
     so a spent motor runs at or under its continuous rating. Whenever the measured
     current exceeds the ceiling the command scale falls; it recovers slowly below it.
 
-    Spent and derated below ``rest_below_scale``, the motor rests (scale 0) until the
-    account has cooled to ``resume_fraction`` of the allowance, then gets the full command
-    back. A track spinning at full slip draws the soil's shear strength whatever its speed
+    Derated below ``rest_below_scale`` with more than ``resume_fraction`` of the allowance
+    used, the motor rests (scale 0) until the account has cooled to ``resume_fraction``,
+    then gets the full command back. A track spinning at full slip draws the soil's shear strength whatever its speed
     command (vehicle.md 6: H at |i| -> 1), so derating it further would not lower its
     current, only slow the belt below the waves' uprush, which it then brakes (README
     "Main job"): short bursts with rests keep the same I2t account and let it move.
@@ -171,7 +171,7 @@ class CurrentLimiter:
         else:
             self.scale += min(s.recover_rate_per_s, s.derate_gain_per_s * -excess) * dt
         self.scale = min(max(self.scale, 0.0), 1.0)
-        if self.used_fraction >= 1.0 and self.scale < s.rest_below_scale:
+        if self.scale < s.rest_below_scale and self.used_fraction > s.resume_fraction:
             self.resting, self.scale = True, 0.0
         return self.scale
 

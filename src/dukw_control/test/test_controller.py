@@ -269,6 +269,24 @@ def test_current_limit_derates_the_track_command(controller_settings):
     assert any('derating' in h.message for h in r.c.healths(r.t))
 
 
+def test_one_hot_motor_derates_both_tracks_alike(controller_settings):
+    r = Rig(dataclasses.replace(controller_settings, closed_loop=False))
+    r.run(1.0, cmd=(1.0, 0.2))
+    for _ in range(300):                                  # only the starboard motor is hot
+        r.t += DT
+        r.c.on_cmd_vel(1.0, 0.2, r.t)
+        r.c.on_track_currents(20.0, 60.0, r.t)
+        r.c.on_pitch(0.0, r.t)
+        r.c.on_attitude(r.t, r.t)
+        r.c.on_traction(0.1, 0.1, 1.0, r.t)
+        out = r.c.step(r.t)
+    assert r.c.current['port'].scale == 1.0 and r.c.current['stbd'].scale < 0.9
+    unscaled = r.c.s.land.mix(1.0, 0.2).sides
+    ratio = out.tracks.stbd / unscaled.stbd
+    assert ratio == pytest.approx(r.c.current['stbd'].scale)
+    assert out.tracks.port == pytest.approx((unscaled.port + 4.0) * ratio)   # + port bias
+
+
 def test_stuck_stops_and_reports_until_a_stop_or_reversal(controller_settings):
     r = Rig(controller_settings)
     r.odom = (0.0, 0.0)

@@ -65,7 +65,7 @@ def test_current_limiter_cools_and_recovers():
     assert lim.heat_a2s == 0.0 and lim.scale == 1.0 and lim.state == CurrentState.OK
 
 
-def test_a_spent_motor_held_at_its_limit_whatever_the_command_rests_then_gets_it_back():
+def test_a_motor_held_at_its_limit_whatever_the_command_rests_then_gets_it_back():
     # a track at full slip: the soil's shear strength sets the current (50 A) at any
     # command above zero, so derating lowers only the belt speed; the limiter rests instead
     lim = CurrentLimiter(dataclasses.replace(CURRENT, rest_below_scale=0.5,
@@ -89,7 +89,24 @@ def test_a_spent_motor_held_at_its_limit_whatever_the_command_rests_then_gets_it
     assert max(scales[-60 * 100:]) == 1.0             # bursts keep coming
 
 
-def test_without_a_rest_scale_a_spent_motor_only_derates():
+def test_a_motor_the_foldback_holds_just_short_of_spent_rests_too():
+    # in the swash: the soil's 32 A at any speed, 6 A of belt friction at full command and
+    # the waves' +-8 A: the ceiling's foldback derates on each crest while the account
+    # creeps towards spent; the motor rests before it is spent, not only after
+    lim = CurrentLimiter(dataclasses.replace(CURRENT, rest_below_scale=0.5,
+                                             resume_fraction=0.3))
+    most_used = 0.0
+    for k in range(120 * 100):
+        wave_a = 8.0 * math.sin(2.0 * math.pi * k * 0.01 / 3.57)
+        lim.update(32.0 + 6.0 * lim.scale + wave_a if lim.scale > 0.0 else 0.0, 0.01)
+        if lim.resting:
+            break
+        most_used = max(most_used, lim.used_fraction)
+    assert lim.state == CurrentState.RESTING
+    assert most_used < 1.0                            # it rested before the account was spent
+
+
+def test_without_a_rest_scale_a_motor_only_derates():
     lim = CurrentLimiter(CURRENT)
     for _ in range(60 * 100):
         lim.update(50.0 if lim.scale > 0.0 else 0.0, 0.01)
