@@ -114,10 +114,11 @@ class CurrentLimiter:
 
     Derated below ``rest_below_scale`` with more than ``resume_fraction`` of the allowance
     used, the motor rests (scale 0) until the account has cooled to ``resume_fraction``,
-    then gets the full command back. A track spinning at full slip draws the soil's shear strength whatever its speed
-    command (vehicle.md 6: H at |i| -> 1), so derating it further would not lower its
-    current, only slow the belt below the waves' uprush, which it then brakes (README
-    "Main job"): short bursts with rests keep the same I2t account and let it move.
+    then gets the full command back. A track spinning at full slip draws the soil's shear
+    strength whatever its speed command (vehicle.md 6: H at |i| -> 1), so derating it
+    further would not lower its current, only slow the belt below the waves' uprush, which
+    it then brakes (README "Main job"): short bursts with rests keep the same I2t account
+    and let it move.
     """
 
     def __init__(self, settings: CurrentLimitSettings) -> None:
