@@ -111,10 +111,8 @@ class HeaveObserver:
     def _afloat(self, ekf: MotionEkf, heave_accel_mps2: float) -> Outcome:
         if not math.isfinite(heave_accel_mps2):
             return Outcome.IGNORED
-        x, contact, body = ekf.x, self.contact, self.vehicle.body
-        rate = float(x[_HEAVE_RATE])
-        volume = (body.displacement_n + contact.heave_mass_kg * heave_accel_mps2
-                  + contact.heave_damping_n_per_mps * rate) / self._rho_g
+        x, contact = ekf.x, self.contact
+        volume = contact.afloat_volume_m3(heave_accel_mps2, float(x[_HEAVE_RATE]), True)
         depth, per_m3 = self.keel_depth_m(volume)
         if not math.isfinite(depth):
             return Outcome.IGNORED
