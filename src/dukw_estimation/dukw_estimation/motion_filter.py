@@ -67,6 +67,10 @@ _H_HEAVE_RATE = np.zeros(N_STATES)
 _H_HEAVE_RATE[_HEAVE_RATE] = 1.0
 _H_HEAVE_RATE.flags.writeable = False
 
+#: floor of cos(roll) cos(pitch) when the body-z specific force is turned vertical (60 deg:
+#: far beyond the vehicle's attitudes, vehicle.md 3: 19 deg the steepest slope tested)
+MIN_TILT_COS = 0.5
+
 class MotionFilter:
     """Pose, twist, gyro bias and GPS bias of base_link in odom (and the EKF's time)."""
 
@@ -181,8 +185,7 @@ class MotionFilter:
         imu, fz = self.imu, self.accel_base[2]
         if imu is None or not math.isfinite(fz):
             return math.nan
-        tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
-        return fz / max(tilt, 0.5) - self.vehicle.body.gravity_mps2
+        return _vertical_specific_force(imu, fz) - self.vehicle.body.gravity_mps2
 
     def gravity_free_accel(self) -> tuple[float, float]:
         """The last IMU sample's surge and sway acceleration at base_link, m/s^2, gravity
@@ -193,8 +196,7 @@ class MotionFilter:
         if imu is None:
             return math.nan, math.nan
         fx, fy, fz = self.accel_base
-        tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
-        g_up = fz / max(tilt, 0.5)
+        g_up = _vertical_specific_force(imu, fz)
         return (fx + g_up * math.sin(imu.pitch_rad),
                 fy - g_up * math.sin(imu.roll_rad) * math.cos(imu.pitch_rad))
 
@@ -368,3 +370,10 @@ class MotionFilter:
         z = -s * math.sin(slope_rad)
         return OdometryEstimate(self.t_s or 0.0, x_m, y_m, z, roll, pitch, yaw, u, v, r,
                                 pose_cov, twist_cov)
+
+
+def _vertical_specific_force(imu, fz_mps2: float) -> float:
+    """The specific force along the vertical from its body-z component and the attitude,
+    f_z / (cos roll cos pitch), m/s^2; the tilt's cosine floored at MIN_TILT_COS."""
+    tilt = math.cos(imu.roll_rad) * math.cos(imu.pitch_rad)
+    return fz_mps2 / max(tilt, MIN_TILT_COS)
