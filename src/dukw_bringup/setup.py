@@ -37,6 +37,7 @@ setup(
             'evaluate = dukw_bringup.evaluate:main',
             # randomized runs on Dask (issue 18)
             'campaign = dukw_bringup.campaign_cli:main',
+            'campaign_compare = dukw_bringup.campaign_compare:main',
         ],
     },
 )
