@@ -62,6 +62,10 @@ class EkfSettings:
     gyro_rps: float = _f('noise.gyro_rps', 'gyro z sigma', 1e-6, 1)
     contact_m: float = _f('noise.contact_m', 'water surface at a wet/dry boundary sigma',
                           1e-4, 1)
+    contact_surface_slope: float = _f(
+        'noise.contact_surface_slope', "the sea surface's slope over the hulls, sigma (rad): "
+        "a wet/dry sensor's surface, taken as level to base_link, is off by it times the "
+        "sensor's distance from base_link", 0, 1)
     depth_m: float = _f('noise.depth_m', 'depth sounder sigma (incl. heave)', 1e-4, 5)
     track_odometry_mps: float = _f('noise.track_odometry_mps',
                                    'track-speed pseudo-measurement sigma (GPS stale)', 1e-3, 10)
@@ -190,6 +194,10 @@ class EkfSettings:
         'weight (0: held tracks never update)', 0, 10)
     force_update_sigma_n: float = _f('force_update.sigma_n', 'per track: current noise, '
                                      'unmodelled friction and paddle thrust (0: off)', 0, 1e4)
+    force_update_surface_m: float = _f(
+        'force_update.surface_sigma_m', "the water at the hulls the one level surface at "
+        "base_link does not place, sigma (m): the force's sensitivity to the surface times it "
+        "joins each update's noise", 0, 1)
     force_update_period_s: float = _f('force_update.period_s', 'at most this often (the '
                                       'smoothed force is correlated in time)', 0, 60)
     force_update_settle_s: float = _f('force_update.settle_s', 'grounded at least this long '

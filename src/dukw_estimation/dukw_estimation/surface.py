@@ -57,7 +57,7 @@ class SurfaceObserver:
             depth, h = self._sensor_depth(ekf.x, x_m, z_m)
             if bool(wet) == (depth > 0.0):
                 continue
-            result = ekf.update_scalar(0.0, depth, h, self.settings.contact_m ** 2,
+            result = ekf.update_scalar(0.0, depth, h, self.contact_variance_m2(x_m),
                                        self.settings.gate_water, only=SURFACE_STATES)
             self.clip_soil_scale(ekf)
             if out is not Outcome.REJECTED_OUTLIER:
@@ -72,6 +72,16 @@ class SurfaceObserver:
             self.dry_t_s = s.t_s
             self.bound_by_dry_sensors(ekf, s.t_s)
         return out
+
+    def contact_variance_m2(self, x_m: float) -> float:
+        """The variance of the surface at a wet/dry sensor ``x_m`` ahead of base_link as a
+        measurement of the surface states, m^2: the boundary's own (``noise.contact_m``) and
+        the sea's slope over the hulls (``noise.contact_surface_slope``), which the one level
+        surface of the states does not have: a wave over the 2.4 m between the sensors lifts
+        one end against the other (issue 18: in the swash the landward sensor stayed wet
+        while the water at base_link fell, and pinned the surface 5-10 cm high)."""
+        st = self.settings
+        return st.contact_m ** 2 + (st.contact_surface_slope * x_m) ** 2
 
     def _bracket(self, ekf: MotionEkf, t_s: float, sensors: tuple) -> None:
         """One sensor wet, the other dry: the surface crosses the hulls somewhere between
@@ -239,7 +249,8 @@ class SurfaceObserver:
         if x[Idx.SOIL] > 0.0:
             h[Idx.SOIL] = predicted / x[Idx.SOIL]    # the force is the factor x the model's
         var = st.force_update_sigma_n ** 2 + per_mps * per_mps * max(ground_var, 0.0) \
-            + soil_spread * max(measured_n * measured_n, predicted * predicted)
+            + soil_spread * max(measured_n * measured_n, predicted * predicted) \
+            + (per_m * st.force_update_surface_m) ** 2
         ekf.update_scalar(measured_n, predicted, h, var, st.force_update_gate,
                           only=SURFACE_STATES if learn_soil else WATER_SURFACE_STATES)
         self.clip_soil_scale(ekf)

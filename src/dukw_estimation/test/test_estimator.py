@@ -429,6 +429,60 @@ def test_held_tracks_slid_by_the_waves_correct_the_surface_not_the_soils_factor(
     assert abs(factor[True] - 1.0) > 0.05
 
 
+def test_where_the_water_could_explain_the_force_the_forces_pin_surface_and_factor_less():
+    """In the surf the force's sensitivity to the surface times the water one level surface
+    at base_link does not place (force_update.surface_sigma_m: the wave is not level over
+    the hulls) joins each update's noise: after a second of updates in a trough the surface
+    and the soil's factor are both left less certain than with the force's noise alone
+    (issue 18: in the swash 20 updates a second had pinned the depth to 1-3 cm while it was
+    3-10 cm off, and the factor took what the water did: run 158, the configured soil,
+    1.0 -> 1.53). On the dry beach the surface cannot change the force: nothing changes."""
+    def spreads(sigma_m, x0):
+        est = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, soil_online_enabled=False,
+                   soil_scale_sigma=0.3, force_update_surface_m=sigma_m)
+        _surf_run(est, -0.06, 0.4, seconds=1.0, x0=x0)
+        h = np.zeros(len(est.ekf.x))
+        h[Idx.ETA], h[Idx.S] = 1.0, math.sin(est.contact.slope_rad)
+        return math.sqrt(h @ est.ekf.P @ h), math.sqrt(est.ekf.P[Idx.SOIL, Idx.SOIL])
+
+    sigma_m = SETTINGS.force_update_surface_m
+    assert sigma_m > 0.0
+    (depth_0, soil_0), (depth_1, soil_1) = spreads(0.0, 5.0), spreads(sigma_m, 5.0)
+    assert depth_1 > 1.05 * depth_0
+    assert soil_1 > 1.05 * soil_0
+    assert spreads(0.0, -3.0) == spreads(sigma_m, -3.0)
+
+
+def test_a_wet_dry_sensor_reads_the_surface_at_its_end_of_the_hulls():
+    """A wet/dry sensor 1.2 m from base_link tells the surface there; the states place one
+    level surface, so the sea's slope over the hulls (noise.contact_surface_slope) times the
+    sensor's distance joins the boundary's sigma, and one disagreeing reading moves the
+    surface less (issue 18: in the swash the landward sensor stayed wet while the water at
+    base_link fell, and its readings held the surface 5-10 cm high)."""
+    slope = SETTINGS.contact_surface_slope
+    assert slope > 0.0
+    shifts = {}
+    for sigma in (0.0, slope):
+        est = make(contact_surface_slope=sigma)
+        x_m = VEHICLE.sensors.fore_water_x_m
+        assert est.surface.contact_variance_m2(x_m) == pytest.approx(
+            SETTINGS.contact_m ** 2 + (sigma * x_m) ** 2)
+        assert est.surface.contact_variance_m2(0.0) == pytest.approx(SETTINGS.contact_m ** 2)
+        est.ekf.x[Idx.S] = -3.0                 # on the dry beach, both sensors dry ...
+        est.ekf.x[Idx.ETA] = 0.0
+        surface = [Idx.S, Idx.ETA, Idx.ETA_RATE]
+        est.ekf.P[surface, :] = 0.0
+        est.ekf.P[:, surface] = 0.0
+        est.ekf.P[Idx.S, Idx.S], est.ekf.P[Idx.ETA, Idx.ETA] = 0.5 ** 2, 0.05 ** 2
+        est.ekf.P[Idx.ETA_RATE, Idx.ETA_RATE] = 0.1 ** 2
+        est.surface.bracket_t_s = 0.5           # the span's middle not due (bracket_period_s)
+        before = float(est.ekf.x[Idx.ETA])
+        est.surface.water_contact(est.ekf, WaterContact(1.0, True, False))   # ... fore wet
+        shifts[sigma] = float(est.ekf.x[Idx.ETA]) - before
+    assert shifts[0.0] > 0.0                   # the surface raised towards the wet sensor
+    assert 0.0 < shifts[slope] < 0.8 * shifts[0.0]
+
+
 def test_a_weaker_beach_is_learnt_as_the_soils_factor_not_read_as_water():
     """On a beach weaker than the configured soil (the paper's 64 % fit), met in the surf with
     no dry sand to learn it first, the tracks' force is short of the configured model's:
