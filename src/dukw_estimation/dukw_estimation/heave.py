@@ -65,6 +65,7 @@ class HeaveObserver:
         self.was_afloat = False
         self.surface_updates = 0
         self.ground_updates = 0
+        self.held_at_beach = 0           # afloat, drafts asking for more water at the beach
 
     def keel_depth_m(self, volume_m3: float) -> tuple[float, float]:
         """(The keel's depth under a level surface with ``volume_m3`` of the hulls under it,
@@ -90,18 +91,23 @@ class HeaveObserver:
         touchdown, self.was_afloat = self.was_afloat, False
         return self._on_sand(ekf, touchdown)
 
+    def _beach_row(self, x: np.ndarray) -> tuple[float, np.ndarray]:
+        """The keel's height over the estimated beach under it, heave + s sin(slope), m,
+        and its Jacobian."""
+        sin_t = math.sin(self.contact.slope_rad)
+        h = np.zeros(N_STATES)
+        h[_HEAVE] = 1.0
+        h[_S] = sin_t
+        return float(x[_HEAVE] + x[_S] * sin_t), h
+
     def _on_sand(self, ekf: MotionEkf, touchdown: bool) -> Outcome:
         """The keel on the beach. At a touchdown the floating hull's keel meets the beach:
         the heave, the wave and the waterline distance tie (the water over the keel is the
         draft it floated at, whatever the slope). On the sand after it the beach's height under
         the keel follows the estimated slope, which may not be the true one (a steeper beach
         lifts the keel faster than s sin(slope) says), so it moves the heave only."""
-        x = ekf.x
-        sin_t = math.sin(self.contact.slope_rad)
-        h = np.zeros(N_STATES)
-        h[_HEAVE] = 1.0
-        h[_S] = sin_t
-        out = ekf.update_scalar(0.0, float(x[_HEAVE] + x[_S] * sin_t), h,
+        clearance, h = self._beach_row(ekf.x)
+        out = ekf.update_scalar(0.0, clearance, h,
                                 self.settings.heave_ground_m ** 2, self.settings.heave_gate,
                                 only=HEAVE_SURFACE_STATES if touchdown else HEAVE_STATES)
         if out is Outcome.ACCEPTED:
@@ -109,12 +115,23 @@ class HeaveObserver:
         return out
 
     def _afloat(self, ekf: MotionEkf, heave_accel_mps2: float) -> Outcome:
+        """Afloat: the keel under the wave by the dynamic draft. But the contact decision
+        may say afloat while the keel lies on the sand (it lags a grounding by the IMU's
+        motion test, which the landing's jolt itself keeps up, and leads a lift-off): with
+        the keel within ``heave.keel_at_beach_m`` of the estimated beach a draft asking for
+        more water than the estimate is not used (a hull lying on the sand has at most its
+        floating draft of water over its keel; the draft of a stopped hull reads as a
+        stopped wave); one asking for less still is."""
         if not math.isfinite(heave_accel_mps2):
             return Outcome.IGNORED
-        x, contact = ekf.x, self.contact
+        x, contact, st = ekf.x, self.contact, self.settings
         volume = contact.afloat_volume_m3(heave_accel_mps2, float(x[_HEAVE_RATE]), True)
         depth, per_m3 = self.keel_depth_m(volume)
         if not math.isfinite(depth):
+            return Outcome.IGNORED
+        if st.heave_keel_at_beach_m > 0.0 and depth > float(x[_ETA] - x[_HEAVE]) \
+                and self._beach_row(x)[0] < st.heave_keel_at_beach_m:
+            self.held_at_beach += 1
             return Outcome.IGNORED
         h = np.zeros(N_STATES)
         h[_ETA] = 1.0

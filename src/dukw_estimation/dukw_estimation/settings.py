@@ -119,6 +119,9 @@ class EkfSettings:
     heave_ground_m: float = _f('heave.ground_sigma_m', 'on the sand: the keel on the beach, '
                                'sigma', 1e-4, 1)
     heave_gate: float = _f('heave.mahalanobis', 'rejection distance of both', 0.5, 1e6)
+    heave_keel_at_beach_m: float = _f('heave.keel_at_beach_m', 'afloat, the keel this close '
+                                      'to the estimated beach may lie on it: the dynamic draft '
+                                      'then bounds the water from above only (0: off)', 0, 1)
     init_heave_m: float = _f('initial_sigma.heave_m', "initial sigma of the keel's height",
                              1e-4, 100)
     init_heave_rate_mps: float = _f('initial_sigma.heave_rate_mps',

@@ -741,6 +741,51 @@ def test_keel_depth_of_the_displacement_is_the_draft():
     assert math.isnan(heave.keel_depth_m(0.0)[0])
 
 
+def _afloat_at(est, keel_over_beach_m, water_over_keel_m, x_m=7.6):
+    """The filter's state for the heave observer's afloat measurement: the waterline distance
+    ``x_m`` (the estimated beach ``x_m`` sin(slope) under base_link), the keel
+    ``keel_over_beach_m`` above it, the surface ``water_over_keel_m`` over the keel, the
+    contact decision afloat, the hull still, its height known to a centimetre."""
+    x = est.ekf.x
+    sin_t = math.sin(est.contact.slope_rad)
+    x[Idx.S] = x_m
+    x[Idx.HEAVE] = -x_m * sin_t + keel_over_beach_m
+    x[Idx.HEAVE_RATE] = 0.0
+    x[Idx.ETA] = x[Idx.HEAVE] + water_over_keel_m
+    x[Idx.ETA_RATE] = 0.0
+    est.ekf.P[:] = np.diag(np.diag(est.ekf.P))
+    est.ekf.P[Idx.HEAVE, Idx.HEAVE] = 0.01 ** 2          # the keel's height known (IMU, DGPS)
+    est.ekf.P[Idx.HEAVE_RATE, Idx.HEAVE_RATE] = 0.01 ** 2
+    est.contact.afloat = True
+    return x
+
+
+def test_afloat_a_keel_at_the_beach_bounds_the_water_from_above_only():
+    """The contact decision lags a grounding (the landing's jolt keeps the IMU's motion test
+    up) and leads a lift-off, so 'afloat' may be a hull lying on the sand, whose keel has at
+    most its floating draft of water over it (campaign run 143: the draft of the stopped hull
+    held the falling wave, its rate -0.15 -> +0.04 m/s in 0.1 s). With the keel within
+    ``heave.keel_at_beach_m`` of the estimated beach a draft asking for more water is not
+    used; one asking for less is, and so is any once the keel is clear of the beach."""
+    body = VEHICLE.body
+    shallow = body.draft_m - 0.05            # 5 cm less water than the floating draft
+    est = make()
+    x = _afloat_at(est, 0.005, shallow)
+    eta, rate = float(x[Idx.ETA]), float(x[Idx.ETA_RATE])
+    assert est.heave.update(est.ekf, 0.0, True) is Outcome.IGNORED
+    assert (x[Idx.ETA], x[Idx.ETA_RATE]) == (eta, rate)
+    assert est.heave.held_at_beach == 1
+    for changes, keel, water in (({'heave_keel_at_beach_m': 0.0}, 0.005, shallow),  # off
+                                 ({}, 0.10, shallow),                 # keel clear: floating
+                                 ({}, 0.005, body.draft_m + 0.05)):   # asking for less water
+        est = make(**changes)
+        x = _afloat_at(est, keel, water)
+        eta = float(x[Idx.ETA])
+        assert est.heave.update(est.ekf, 0.0, True) is Outcome.ACCEPTED
+        assert abs(x[Idx.ETA] - eta) > 0.005
+        assert est.heave.held_at_beach == 0
+
+
 def _surf_samples():
     """A vehicle 6 m out in the surf: lying still, then rolling and heaving like a hull
     afloat, then still again, with fixes, tracks pushing and wet/dry sensors (the afloat /
