@@ -72,6 +72,15 @@ class ContactModel:
         heave = heave_constants(body, settings.heave_natural_hz, settings.heave_damping_ratio)
         self.heave_mass_kg = heave.mass_kg
         self.heave_damping_n_per_mps = heave.damping_n_per_mps
+        # the most a floating hull's heave acceleration can be, up (the hulls awash: their most
+        # buoyancy) and down (none), with the damping at the fastest heave, m/s^2 (inf: off)
+        rate = settings.contact_impact_heave_rate_mps
+        damping = self.heave_damping_n_per_mps * rate
+        rho_g = body.water_density_kgpm3 * body.gravity_mps2
+        self.impact_accel_mps2 = (rho_g * self.max_volume_m3 - body.displacement_n + damping) \
+            / self.heave_mass_kg if rate > 0.0 else math.inf
+        self.drop_accel_mps2 = (body.displacement_n + damping) / self.heave_mass_kg \
+            if rate > 0.0 else math.inf
         self.reset()
 
     def reset(self) -> None:
@@ -81,6 +90,7 @@ class ContactModel:
         self.fraction = 1.0
         self.afloat = False
         self.motion_level = 0.0          # > 1: rolling, pitching, heaving like a floating hull
+        self.impacts = 0                 # IMU samples taken as the sand striking the keel
         self.force = [ForceSmoother(st.force_process_n_per_s, st.force_measurement_n)
                       for _ in range(2)]
         # per track: ((status, smoothed force), its soil force) last worked out
@@ -96,10 +106,22 @@ class ContactModel:
         """Low-pass of (roll/pitch rate, heave acceleration) over their thresholds, squared."""
         st = self.settings
         heave = heave if math.isfinite(heave) else 0.0
+        if self.impact(heave):
+            # the sand striking the keel: not floating motion, and the hull is on the sand now
+            self.impacts += 1
+            self.motion_level = 0.0
+            return
         level = ((s.roll_rate_rps ** 2 + s.pitch_rate_rps ** 2) / st.contact_rate_rps ** 2
                  + heave ** 2 / st.contact_accel_mps2 ** 2)
         alpha = min(dt / st.contact_time_constant_s, 1.0) if dt > 0.0 else 1.0
         self.motion_level += alpha * (level - self.motion_level)
+
+    def impact(self, heave_accel_mps2: float) -> bool:
+        """A heave acceleration no floating hull can have (beyond what the buoyancy of the
+        hulls awash, or of none, and the damping at ``contact.impact_heave_rate_mps`` give):
+        the sand striking the keel, or its rebound."""
+        return heave_accel_mps2 > self.impact_accel_mps2 \
+            or heave_accel_mps2 < -self.drop_accel_mps2
 
     def update_slope(self, s: ImuSample, yaw_rad: float, dt: float) -> None:
         """Low-pass the beach slope along the seaward direction from pitch and roll."""

@@ -65,6 +65,8 @@ class HeaveObserver:
         self.was_afloat = False
         self.surface_updates = 0
         self.ground_updates = 0
+        self.last_accel_mps2 = math.nan  # the last heave acceleration short of an impact
+        self.impact_drafts = 0           # drafts measured when the sand struck the keel
         self.held_at_beach = 0           # afloat, drafts asking for more water at the beach
 
     def keel_depth_m(self, volume_m3: float) -> tuple[float, float]:
@@ -82,9 +84,22 @@ class HeaveObserver:
         """The measurement the contact decision implies, for one IMU sample: afloat the keel
         under the wave by the dynamic draft, on the sand the keel on the beach. Nothing before
         the filter is ``placed`` (its first fix: the waterline distance, the contact decision
-        follow from there)."""
+        follow from there).
+
+        An impact (``ContactModel.impact``: the sand striking the keel) is the touchdown
+        itself, whatever the contact decision says (it may have said the sand while the hull
+        still floated): the hull floated up to the sample before, so the water over the keel
+        is the dynamic draft of that sample's acceleration, measured then, with the keel at
+        the beach (the keel-at-beach bound does not apply)."""
         if not placed:
             return Outcome.IGNORED
+        impact = self.contact.impact(heave_accel_mps2)
+        floated = self.last_accel_mps2
+        if not impact:
+            self.last_accel_mps2 = heave_accel_mps2
+        elif math.isfinite(floated) and self._afloat(ekf, floated, at_impact=True) \
+                is Outcome.ACCEPTED:
+            self.impact_drafts += 1
         if self.contact.afloat:
             self.was_afloat = True
             return self._afloat(ekf, heave_accel_mps2)
@@ -114,22 +129,27 @@ class HeaveObserver:
             self.ground_updates += 1
         return out
 
-    def _afloat(self, ekf: MotionEkf, heave_accel_mps2: float) -> Outcome:
+    def _afloat(self, ekf: MotionEkf, heave_accel_mps2: float, at_impact: bool = False
+                ) -> Outcome:
         """Afloat: the keel under the wave by the dynamic draft. But the contact decision
         may say afloat while the keel lies on the sand (it lags a grounding by the IMU's
         motion test, which the landing's jolt itself keeps up, and leads a lift-off): with
         the keel within ``heave.keel_at_beach_m`` of the estimated beach a draft asking for
         more water than the estimate is not used (a hull lying on the sand has at most its
         floating draft of water over its keel; the draft of a stopped hull reads as a
-        stopped wave); one asking for less still is."""
+        stopped wave); one asking for less still is. ``at_impact``: the draft the hull
+        floated at when the sand struck (``update``)."""
         if not math.isfinite(heave_accel_mps2):
             return Outcome.IGNORED
         x, contact, st = ekf.x, self.contact, self.settings
+        if contact.impact(heave_accel_mps2):
+            return Outcome.IGNORED       # the sand striking the keel is not a draft
         volume = contact.afloat_volume_m3(heave_accel_mps2, float(x[_HEAVE_RATE]), True)
         depth, per_m3 = self.keel_depth_m(volume)
         if not math.isfinite(depth):
             return Outcome.IGNORED
-        if st.heave_keel_at_beach_m > 0.0 and depth > float(x[_ETA] - x[_HEAVE]) \
+        if not at_impact and st.heave_keel_at_beach_m > 0.0 \
+                and depth > float(x[_ETA] - x[_HEAVE]) \
                 and self._beach_row(x)[0] < st.heave_keel_at_beach_m:
             self.held_at_beach += 1
             return Outcome.IGNORED

@@ -132,6 +132,10 @@ class EkfSettings:
                                    'heave acceleration scale for the same test', 1e-4, 100)
     contact_time_constant_s: float = _f('contact.time_constant_s',
                                         'low-pass of that motion test', 1e-3, 10)
+    contact_impact_heave_rate_mps: float = _f(
+        'contact.impact_heave_rate_mps', 'the fastest a floating hull heaves: a heave '
+        'acceleration beyond what the buoyancy of the hulls awash and the damping at this '
+        'rate give is the sand striking the keel (0: off)', 0, 10)
     contact_min_volume_share: float = _f('contact.min_volume_share',
                                          'floating needs at least this share of the '
                                          'displacement under water (bumps on land)', 0, 1)
