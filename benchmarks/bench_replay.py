@@ -18,6 +18,7 @@ from dukw_bringup import bag_io
 from dukw_bringup import replay as replay_module
 from dukw_bringup.replay import replay, stream
 from dukw_bringup.replay_adapters import ADAPTERS, CoreAdapter, EkfAdapter
+from dukw_common.node_tools import stamp_or
 from dukw_estimation import ros_convert
 from figures import report
 from profile_text import profile_to_text
@@ -58,7 +59,7 @@ def estimator_inputs(bag: Path) -> list[tuple[str, float, object]]:
     """The estimator's inputs of ``bag``, decoded and converted: (topic key, t_s, sample)."""
     store = bag_io.typestore()
     with bag_io.BagReader(bag) as reader:
-        convert, stamp_or = ros_convert.SAMPLE_FROM_MSG, ros_convert.stamp_or
+        convert = ros_convert.SAMPLE_FROM_MSG
         return [(key, t_s, convert[key](msg, stamp_or(msg, t_s)))
                 for key, t_s, msg in ((bag_io.topic_key(m.topic), m.timestamp_ns * 1e-9,
                                        bag_io.deserialize(m, store))

@@ -127,11 +127,11 @@ class BagWire:
     def received(topic: str, t_ns: int, msg):
         """What a subscribing node makes of ``msg`` (the nodes' conversions)."""
         from dukw_common.cmd_vel import read_cmd_vel
+        from dukw_common.node_tools import stamp_or
         from dukw_control.convert import decision_from_msg
         from dukw_estimation import ros_convert
         if topic in SENSOR_TOPICS:
-            return ros_convert.SAMPLE_FROM_MSG[topic](msg, ros_convert.stamp_or(msg,
-                                                                                t_ns * 1e-9))
+            return ros_convert.SAMPLE_FROM_MSG[topic](msg, stamp_or(msg, t_ns * 1e-9))
         if topic == 'odometry/filtered':
             return ros_convert.odometry_estimate(msg)
         if topic == 'traction':

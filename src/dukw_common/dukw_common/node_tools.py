@@ -335,6 +335,12 @@ def stamp_s_or(sec: int, nanosec: int, fallback_s: float) -> float:
     return t_s if t_s > 0.0 else fallback_s
 
 
+def stamp_or(msg, fallback_s: float) -> float:
+    """A message's header stamp in seconds, or ``fallback_s`` when it is unset (zero)."""
+    stamp = msg.header.stamp
+    return stamp_s_or(stamp.sec, stamp.nanosec, fallback_s)
+
+
 def s_to_stamp(t_s: float):
     """Seconds -> builtin_interfaces/Time."""
     from builtin_interfaces.msg import Time

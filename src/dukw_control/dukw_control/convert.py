@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 from dukw_common.geometry import euler_from_quaternion
-from dukw_common.node_tools import stamp_s_or
 from dukw_msgs.msg import Authority, DiffCommand, DriveMode
 
 from dukw_control.mixer import NEUTRAL, SidePair
@@ -83,8 +82,3 @@ def quaternion_pitch_rad(x: float, y: float, z: float, w: float) -> float:
     """REP 103 pitch (positive nose down) from a quaternion's components."""
     return euler_from_quaternion(x, y, z, w)[1]
 
-
-def stamp_or(msg, fallback_s: float) -> float:
-    """The header stamp in seconds, or ``fallback_s`` when it is unset (zero)."""
-    stamp = msg.header.stamp
-    return stamp_s_or(stamp.sec, stamp.nanosec, fallback_s)

@@ -15,11 +15,11 @@ from sensor_msgs.msg import Imu
 from dukw_common.cmd_vel import CMD_VEL_STAMPED_SPEC, cmd_vel_type, read_cmd_vel
 from dukw_common.config import ConfigError
 from dukw_common.node_tools import (COMMAND_QOS, STATE_QOS, ParamSpec, declare_parameters,
-                                    diagnostic_array, publisher_sources, run_node,
+                                    diagnostic_array, publisher_sources, run_node, stamp_or,
                                     subscribe_sensors, vehicle_specs)
 from dukw_control.controller import NODE_PARAMS, ControlOutput
 from dukw_control.convert import (ActuatorPublishers, authority_usable, decision_from_msg,
-                                  pitch_from_quaternion, stamp_or)
+                                  pitch_from_quaternion)
 from dukw_control.runners import DriveControllerRunner
 
 

@@ -18,8 +18,9 @@ from dukw_common.diagnostics import Health, Level
 from dukw_common.sources import SourceWatch
 from dukw_common.node_tools import (COMMAND_QOS, STATE_QOS, LatestSamples, ParamSpec,
                                     declare_parameters, diagnostic_array,
-                                    refuse_second_client, run_node, subscribe_sensors)
-from dukw_control.convert import decision_to_msg, stamp_or
+                                    refuse_second_client, run_node, stamp_or,
+                                    subscribe_sensors)
+from dukw_control.convert import decision_to_msg
 from dukw_control.modes import NODE_PARAMS, Mode, ModeDecision
 from dukw_control.runners import ModeManagerRunner
 

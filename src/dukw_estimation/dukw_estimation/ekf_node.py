@@ -23,7 +23,8 @@ from dukw_common.config import node_params, section
 from dukw_common.diagnostics import Health, Level
 from dukw_common.node_tools import (COMMAND_QOS, ParamSpec, declare_parameters,
                                     diagnostic_array, refuse_second_client, run_node,
-                                    s_to_stamp, subscribe_sensors, vehicle_specs)
+                                    s_to_stamp, stamp_or, subscribe_sensors,
+                                    vehicle_specs)
 from dukw_common.sources import SourceWatch
 from dukw_common.tf_tools import TF_QOS, odometry_tf
 from dukw_estimation import ros_convert as conv
@@ -78,7 +79,7 @@ class EkfNode(Node):
 
         def callback(msg) -> None:
             now = self._now_s()
-            self._publish(self.runner.on_sample(topic, convert(msg, conv.stamp_or(msg, now)),
+            self._publish(self.runner.on_sample(topic, convert(msg, stamp_or(msg, now)),
                                                 now))
         return callback
 

@@ -14,7 +14,7 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import NavSatStatus
 
 from dukw_common.geometry import euler_from_quaternion, quaternion_from_euler
-from dukw_common.node_tools import stamp_s_or, stamp_to_s
+from dukw_common.node_tools import stamp_to_s
 from dukw_common.readings import (DepthReading, DriveStatus, GpsFix, GpsVelocity, ImuSample,
                                   MotorSide, WaterContact, positional_builder)
 from dukw_estimation.samples import OdometryEstimate, TractionEstimate
@@ -224,8 +224,3 @@ def traction_msg(est: TractionEstimate, stamp, msg_type):
     msg.afloat = bool(est.afloat)
     return msg
 
-
-def stamp_or(msg, fallback_s: float) -> float:
-    """The header stamp in seconds, or ``fallback_s`` when it is unset (zero)."""
-    stamp = msg.header.stamp
-    return stamp_s_or(stamp.sec, stamp.nanosec, fallback_s)
