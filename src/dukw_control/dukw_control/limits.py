@@ -88,7 +88,8 @@ class CurrentLimitSettings:
     derate_gain_per_s: float       # command scale lost per second per unit relative overcurrent
     recover_rate_per_s: float      # command scale regained per second below the ceiling
     rest_below_scale: float = 0.0  # derated below this: stop and cool (0: never) ...
-    resume_fraction: float = 0.3   # ... until the account is back to this share of it
+    resume_fraction: float = 0.0   # ... until the account is back to this share of it
+                                   # (both from config/dukw.yaml current.*; the defaults: off)
 
     def __post_init__(self) -> None:
         if not 0 < self.continuous_a <= self.peak_a:
