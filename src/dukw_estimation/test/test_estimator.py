@@ -645,15 +645,15 @@ def test_both_tracks_pushing_hard_mean_the_sand_even_when_the_imu_rolls():
     volume = VEHICLE.body.displaced_volume_m3 * 1.1
     assert not contact.floating(volume, True, contact.tracks_pushing(status, True))
     for k, smoother in enumerate(contact.force):     # paddling: the friction and a little more
-        smoother.kf.x[0, 0] = drive.track_friction_n(k == 0) + 20.0
+        smoother.x[0] = drive.track_friction_n(k == 0) + 20.0
     assert not contact.tracks_pushing(status, True)
     assert contact.floating(volume, True, contact.tracks_pushing(status, True))
     held = tracks(1.0, 0.0, 0.0)                # held belts braking a vehicle on the sand
     for smoother in contact.force:
-        smoother.kf.x[0, 0] = -120.0
+        smoother.x[0] = -120.0
     assert contact.tracks_pushing(held, True)
     for smoother in contact.force:              # held belts dragged through the water
-        smoother.kf.x[0, 0] = -10.0
+        smoother.x[0] = -10.0
     assert not contact.tracks_pushing(held, True)
 
 
