@@ -89,9 +89,9 @@ else
     > "$ROOT/.colcon-build.txt" 2>&1 || { tail -50 "$ROOT/.colcon-build.txt" >&2; exit 1; } 
   # The EKF's numba kernels compiled into their cache beside the built module (a node's
   # first sample, or a test's, would otherwise wait seconds for the compiler).
-  log "compiling the EKF kernels (numba cache)"
+  log "compiling the EKF and stance kernels (numba cache)"
   "$VENV/bin/python" -c "import sys; sys.path.insert(0, '$ROOT/build/dukw_estimation'); \
-import dukw_estimation.ekf_kernels as k; k.warm()"
+import dukw_estimation.ekf_kernels as k, dukw_estimation.stance as s; k.warm(); s.warm()"
   touch "$build_stamp"
 fi
 log "ready: source scripts/env.sh"

@@ -30,14 +30,17 @@ estimator: not afloat).
 from __future__ import annotations
 
 import math
-from collections import deque
 from math import isfinite
-from operator import truediv
 from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
 
 from dukw_common.readings import ImuSample
 
 _CHANNELS = 6
+#: the window's first room, samples (grown when a faster IMU fills it)
+_START_CAPACITY = 128
 
 
 @dataclass(frozen=True)
@@ -80,13 +83,13 @@ class StanceDetector:
 
     def reset(self) -> None:
         """Forget the window."""
-        self._window: deque[tuple[float, tuple[float, ...], tuple[float, ...]]] = deque()
-        self._sum = [0.0] * _CHANNELS
-        self._sum_sq = [0.0] * _CHANNELS
-        self._sum_mean = [0.0] * 4        # gravity-free surge, sway accel; roll, pitch rate
+        self._times = np.zeros(_START_CAPACITY)              # the window: a ring of samples
+        self._z = np.zeros((_START_CAPACITY, _CHANNELS))    # their channels over their noise
+        self._raw = np.zeros((_START_CAPACITY, 4))          # and the means' four values
+        self._sums = np.zeros(2 * _CHANNELS + 4)            # sum z, sum z^2, sum raw
+        self._ring = np.zeros(3, dtype=np.int64)            # oldest, count, added since recompute
         self._since_t = math.nan          # the first sample of the unbroken run
         self._last_t = -math.inf
-        self._added = 0                   # since the sums were last recomputed
         self.statistic = math.nan         # the last window's statistic (1 ~ noise alone)
         self.mean_accel_mps2 = math.nan   # and its mean gravity-free acceleration
         self.mean_rate_rps = math.nan     # and its mean roll and pitch rate
@@ -104,35 +107,32 @@ class StanceDetector:
             self.reset()
             if not finite:
                 return False
-        z = tuple(map(truediv, values, self._sigmas(s)))      # (six of each)
         if math.isnan(self._since_t):
             self._since_t = s.t_s
         self._last_t = s.t_s
-        window, total, total_sq = self._window, self._sum, self._sum_sq
-        means = self._sum_mean
         raw = (accel_mps2[0], accel_mps2[1], s.roll_rate_rps, s.pitch_rate_rps)
-        window.append((s.t_s, z, raw))
-        for i in range(_CHANNELS):
-            total[i] += z[i]
-            total_sq[i] += z[i] * z[i]
-        for i in range(4):
-            means[i] += raw[i]
-        while window[0][0] <= s.t_s - st.window_s:
-            _, old, old_raw = window.popleft()
-            for i in range(_CHANNELS):
-                total[i] -= old[i]
-                total_sq[i] -= old[i] * old[i]
-            for i in range(4):
-                means[i] -= old_raw[i]
-        self._added += 1
-        n = len(window)
-        if self._added >= n:              # the running sums' rounding, once per window
-            self._recompute()
+        window = (self._times, self._z, self._raw, self._sums, self._ring)
+        result = _push(*window, s.t_s, values, self._sigmas(s), raw, st.window_s)
+        while result[0] < 0:              # the ring is full: twice the room, oldest first
+            self._grow()
+            result = _push(self._times, self._z, self._raw, self._sums, self._ring, s.t_s,
+                           values, self._sigmas(s), raw, st.window_s)
+        n = result[0]
         if n < 2 or s.t_s - self._since_t < st.window_s:
             self.statistic = self.mean_accel_mps2 = self.mean_rate_rps = math.nan
             self.still = False
             return False
-        return self._decide(n)
+        return self._decide(*result)
+
+    def _grow(self) -> None:
+        head, count = int(self._ring[0]), int(self._ring[1])
+        order = (np.arange(count) + head) % self._times.shape[0]
+        for name in ('_times', '_z', '_raw'):
+            old = getattr(self, name)
+            grown = np.zeros((2 * old.shape[0],) + old.shape[1:])
+            grown[:count] = old[order]
+            setattr(self, name, grown)
+        self._ring[0] = 0
 
     def _sigmas(self, s: ImuSample) -> tuple[float, ...]:
         """The six channels' noise: the sample's own variances, else the settings' (the
@@ -152,24 +152,82 @@ class StanceDetector:
                 _sigma(s.pitch_rate_var_rps2, st.gyro_sigma_rps),
                 _sigma(s.yaw_rate_var_rps2, st.gyro_sigma_rps))
 
-    def _decide(self, n: int) -> bool:
-        """The window's statistic and means from the running sums of its ``n`` samples, and
-        whether all three are under their thresholds."""
+    def _decide(self, n: int, deviation: float, accel_x: float, accel_y: float, rate_x: float,
+                rate_y: float) -> bool:
+        """The window's statistic and means from its ``n`` samples' summed squared
+        deviations and summed values, and whether all three are under their thresholds."""
         st = self.settings
-        total, total_sq = self._sum, self._sum_sq
-        deviation = sum(max(total_sq[i] - total[i] * total[i] / n, 0.0)
-                        for i in range(_CHANNELS))
         self.statistic = deviation / (_CHANNELS * (n - 1))
-        means = self._sum_mean
-        self.mean_accel_mps2 = math.hypot(means[0], means[1]) / n
-        self.mean_rate_rps = math.hypot(means[2], means[3]) / n
+        self.mean_accel_mps2 = math.hypot(accel_x, accel_y) / n
+        self.mean_rate_rps = math.hypot(rate_x, rate_y) / n
         self.still = (self.statistic < st.threshold and self.mean_accel_mps2 < st.mean_accel_mps2
                       and self.mean_rate_rps < st.mean_rate_rps)
         return self.still
 
-    def _recompute(self) -> None:
-        window = self._window
-        self._sum = [sum(z[i] for _, z, _ in window) for i in range(_CHANNELS)]
-        self._sum_sq = [sum(z[i] * z[i] for _, z, _ in window) for i in range(_CHANNELS)]
-        self._sum_mean = [sum(a[k] for _, _, a in window) for k in range(4)]
-        self._added = 0
+
+@njit(cache=True)
+def _push(times: np.ndarray, z: np.ndarray, raw: np.ndarray, sums: np.ndarray,
+          ring: np.ndarray, t_s: float, values: tuple, sigmas: tuple, raw_values: tuple,
+          window_s: float) -> tuple:
+    """One sample into the ring (``ring``: oldest index, count, samples added since the sums
+    were recomputed), the samples ``window_s`` older out, the running sums kept (recomputed
+    once per window: their rounding). Returns (count, the six channels' summed squared
+    deviations from their means, the four raw sums); count -1: the ring is full, nothing
+    done. Compiled: the per-channel Python loops were most of the detector's ~6 us a sample
+    (issue 16); the sums are the same additions in the same order."""
+    capacity = times.shape[0]
+    head, count = ring[0], ring[1]
+    if count == capacity:
+        return -1, 0.0, 0.0, 0.0, 0.0, 0.0
+    new = (head + count) % capacity
+    times[new] = t_s
+    for c in range(6):
+        value = values[c] / sigmas[c]
+        z[new, c] = value
+        sums[c] += value
+        sums[6 + c] += value * value
+    for c in range(4):
+        raw[new, c] = raw_values[c]
+        sums[12 + c] += raw_values[c]
+    count += 1
+    while times[head] <= t_s - window_s:
+        for c in range(6):
+            sums[c] -= z[head, c]
+            sums[6 + c] -= z[head, c] * z[head, c]
+        for c in range(4):
+            sums[12 + c] -= raw[head, c]
+        head = (head + 1) % capacity
+        count -= 1
+    ring[0], ring[1] = head, count
+    ring[2] += 1
+    if ring[2] >= count:
+        _recompute(z, raw, sums, head, count)
+        ring[2] = 0
+    deviation = 0.0
+    for c in range(6):
+        deviation += max(sums[6 + c] - sums[c] * sums[c] / count, 0.0)
+    return count, deviation, sums[12], sums[13], sums[14], sums[15]
+
+
+@njit(cache=True)
+def _recompute(z: np.ndarray, raw: np.ndarray, sums: np.ndarray, head: int,
+               count: int) -> None:
+    """The running sums anew from the window's samples, oldest first."""
+    capacity = z.shape[0]
+    sums[:] = 0.0
+    for k in range(count):
+        i = (head + k) % capacity
+        for c in range(6):
+            sums[c] += z[i, c]
+            sums[6 + c] += z[i, c] * z[i, c]
+        for c in range(4):
+            sums[12 + c] += raw[i, c]
+
+
+def warm() -> None:
+    """Compile (or load) the kernels for the types the detector passes (``make setup`` runs
+    this once per build, like ``ekf_kernels.warm``)."""
+    detector = StanceDetector(StanceSettings(0.5, 2.0, 0.02, 0.002, 0.05, 0.02))
+    for k in range(3):
+        detector.add(ImuSample(0.1 * k, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 9.8),
+                     (0.0, 0.0))

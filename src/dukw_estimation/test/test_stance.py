@@ -91,3 +91,39 @@ def test_the_noise_follows_the_samples_own_variances_when_they_change():
             reference.add(ImuSample(*values, *variances), (noise[3], noise[4]))
     assert reference.statistic == pytest.approx(changing.statistic, rel=1e-9)
     assert changing.statistic == pytest.approx(0.25, rel=0.5)
+
+
+def _window_figures(rows, raws, window_s):
+    """The statistic, mean acceleration and mean rate of the samples within ``window_s`` of
+    the last one, computed from scratch."""
+    last_t = rows[-1][0]
+    window = [k for k, (t, _) in enumerate(rows) if t > last_t - window_s]
+    z, n = np.array([rows[k][1] for k in window]), len(window)
+    statistic = np.sum(np.sum(z * z, axis=0) - np.sum(z, axis=0) ** 2 / n) / (6 * (n - 1))
+    means = np.array([raws[k] for k in window]).mean(axis=0)
+    return n, statistic, math.hypot(means[0], means[1]), math.hypot(means[2], means[3])
+
+
+def test_a_fast_imu_fills_a_longer_window_and_the_statistic_is_the_windows():
+    """After 2 s at 100 Hz (the ring has wrapped) the IMU goes to 1 kHz: the 0.5 s window
+    then holds 500 samples (the ring grows past its first room, oldest first); after every
+    sample the statistic and means are those of exactly the samples of the last window_s."""
+    detector = StanceDetector(SETTINGS)
+    rng = np.random.default_rng(5)
+    sigmas = np.array([0.01] * 3 + [0.003] * 3)
+    rows, raws, sizes = [], [], set()
+    for k in range(1, 1201):
+        t = k * 0.01 if k <= 200 else 2.0 + (k - 200) * 0.001
+        values = rng.normal(0.0, 1.0, 6) * sigmas + np.array([0, 0, G, 0.02 * t, 0, 0])
+        accel = (float(rng.normal(0.0, 0.01)), 0.05)
+        detector.add(ImuSample(t, 0.0, 0.0, 0.0, *values[3:], *values[:3]), accel)
+        rows.append((t, values / sigmas))
+        raws.append((accel[0], accel[1], values[3], values[4]))
+        if k < 60:
+            continue
+        n, statistic, mean_accel, mean_rate = _window_figures(rows, raws, SETTINGS.window_s)
+        sizes.add(n)
+        assert detector.statistic == pytest.approx(statistic, rel=1e-9), k
+        assert detector.mean_accel_mps2 == pytest.approx(mean_accel, rel=1e-9), k
+        assert detector.mean_rate_rps == pytest.approx(mean_rate, rel=1e-9), k
+    assert max(sizes) >= 500           # (501 where t - window_s rounds onto a sample)
