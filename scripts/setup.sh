@@ -89,9 +89,10 @@ else
     > "$ROOT/.colcon-build.txt" 2>&1 || { tail -50 "$ROOT/.colcon-build.txt" >&2; exit 1; } 
   # The EKF's numba kernels compiled into their cache beside the built module (a node's
   # first sample, or a test's, would otherwise wait seconds for the compiler).
-  log "compiling the EKF and stance kernels (numba cache)"
-  "$VENV/bin/python" -c "import sys; sys.path.insert(0, '$ROOT/build/dukw_estimation'); \
-import dukw_estimation.ekf_kernels as k, dukw_estimation.stance as s; k.warm(); s.warm()"
+  log "compiling the EKF, stance and hull-volume kernels (numba cache)"
+  "$VENV/bin/python" -c "import sys; sys.path[:0] = ['$ROOT/build/dukw_estimation', '$ROOT/build/dukw_common', \
+'$ROOT/build/dukw_model']; import dukw_estimation.ekf_kernels as k, dukw_estimation.stance as s, \
+dukw_model.buoyancy as b; k.warm(); s.warm(); b.warm()"
   touch "$build_stamp"
 fi
 log "ready: source scripts/env.sh"

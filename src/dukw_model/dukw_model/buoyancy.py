@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
+from numba import njit
 
 from dukw_model.scalars import is_scalar
 from dukw_model.fast_numpy import clip as _clip, operand as _operand
@@ -87,11 +88,14 @@ def _segment_area_array(depth_m: np.ndarray, r: float) -> np.ndarray:
     return r * r * np.arccos(cos_half) - h * np.sqrt(np.maximum(r * r - h * h, 0))
 
 
+@njit(cache=True)
 def segment_area_integral_m3_per_m(depth_m: float, radius_m: float) -> float:
     """Integral of the segment area over water depth, int_0^d A(u) du, m^3/m (exact).
 
     A hull bottom line dipping by g per metre holds F(d2)/g - F(d1)/g between the depths d1
     and d2 at its ends. Beyond 2r the whole circle adds pi r^2 per metre of depth.
+    Compiled (numba), like the helpers it calls: the estimator integrates a wet hull's
+    line at every sample in the surf (issue 16).
     """
     r = radius_m
     d = max(depth_m, 0.0)
@@ -100,11 +104,39 @@ def segment_area_integral_m3_per_m(depth_m: float, radius_m: float) -> float:
     return -_segment_antiderivative(r - inside, r) + math.pi * r * r * max(d - full, 0.0)
 
 
+@njit(cache=True)
 def _segment_antiderivative(v: float, r: float) -> float:
     """Antiderivative of the segment area in v = r - u,
     A(v) = r^2 acos(v/r) - v sqrt(r^2 - v^2)."""
     root = math.sqrt(max(r * r - v * v, 0.0))
-    return r * r * (v * math.acos(max(-1.0, min(1.0, v / r))) - root) + root ** 3 / 3.0
+    return r * r * (v * math.acos(max(-1.0, min(1.0, v / r))) - root) + math.pow(root, 3.0) / 3.0
+
+
+@njit(cache=True)
+def _area_integral(depth_m: float, radius_m: float, float_depth_m: float,
+                   strut_width_m: float, top_depth_m: float, float_area_m2: float,
+                   top_area_m2: float) -> float:
+    """``HullSection.area_integral_m3_per_m`` of the section with these dimensions and its
+    areas at the float line and with the deck awash."""
+    over_deck = max(depth_m - top_depth_m, 0.0)
+    depth_m = min(depth_m, top_depth_m)
+    above = max(depth_m - float_depth_m, 0.0)
+    return segment_area_integral_m3_per_m(min(depth_m, float_depth_m), radius_m) \
+        + float_area_m2 * above \
+        + 0.5 * strut_width_m * above * above \
+        + (top_area_m2 * over_deck if over_deck > 0.0 else 0.0)
+
+
+@njit(cache=True)
+def _sloped_line_volume(depth0_m: float, gradient: float, bow_x_m: float, stern_x_m: float,
+                        radius_m: float, float_depth_m: float, strut_width_m: float,
+                        top_depth_m: float, float_area_m2: float, top_area_m2: float) -> float:
+    """``HullSection.line_volume_m3`` of a sloping bottom line (gradient not ~0), m^3."""
+    bow = _area_integral(depth0_m + gradient * bow_x_m, radius_m, float_depth_m,
+                         strut_width_m, top_depth_m, float_area_m2, top_area_m2)
+    stern = _area_integral(depth0_m + gradient * stern_x_m, radius_m, float_depth_m,
+                           strut_width_m, top_depth_m, float_area_m2, top_area_m2)
+    return abs(bow - stern) / abs(gradient)
 
 
 def cylinder_float_depth_m(displaced_volume_m3: float, radius_m: float,
@@ -245,14 +277,8 @@ class HullSection:
 
     def area_integral_m3_per_m(self, depth_m: float) -> float:
         """int_0^d area(u) du, m^3/m: the volume of a hull dipping 1 m per metre to depth d."""
-        over_deck = max(depth_m - self.top_depth_m, 0.0)
-        depth_m = min(depth_m, self.top_depth_m)
-        f = self.float_depth_m
-        above = max(depth_m - f, 0.0)
-        return segment_area_integral_m3_per_m(min(depth_m, f), self.radius_m) \
-            + self._float_area_m2 * above \
-            + 0.5 * self.strut_width_m * above * above \
-            + (self._top_area_m2 * over_deck if over_deck > 0.0 else 0.0)
+        return _area_integral(depth_m, self.radius_m, self.float_depth_m, self.strut_width_m,
+                              self.top_depth_m, self._float_area_m2, self._top_area_m2)
 
     def line_volume_m3(self, depth0_m: float, gradient: float, bow_x_m: float,
                        stern_x_m: float) -> float:
@@ -260,9 +286,16 @@ class HullSection:
         over it (body x), m^3, exact."""
         if abs(gradient) < 1e-9:
             return float(self.area_m2(depth0_m)) * (bow_x_m - stern_x_m)
-        ends = (depth0_m + gradient * bow_x_m, depth0_m + gradient * stern_x_m)
-        return abs(self.area_integral_m3_per_m(ends[0])
-                   - self.area_integral_m3_per_m(ends[1])) / abs(gradient)
+        return _sloped_line_volume(depth0_m, gradient, bow_x_m, stern_x_m, self.radius_m,
+                                   self.float_depth_m, self.strut_width_m, self.top_depth_m,
+                                   self._float_area_m2, self._top_area_m2)
+
+
+def warm() -> None:
+    """Compile (or load) the kernels (``make setup`` runs this once per build)."""
+    section = HullSection(0.2, 0.3, 0.1, 0.5)
+    section.line_volume_m3(0.1, 0.05, 1.0, -1.0)
+    segment_area_integral_m3_per_m(0.1, 0.2)
 
 
 def hull_volume_from_depths(depths_m: np.ndarray, radius_m: float, length_m: float) -> float:
