@@ -109,22 +109,31 @@ def predict(x: np.ndarray, P: np.ndarray, q_rate: np.ndarray, dt: float, mode: i
 
 @njit(cache=True)
 def _propagate(F: np.ndarray, P: np.ndarray) -> None:
-    """P = F P F^T in place, skipping F's zeros (F is the identity plus a few terms)."""
+    """P = F P F^T in place over F's nonzeros only (F is the identity plus a few terms):
+    each row's nonzero columns listed once, then both products run over them in ascending
+    column order, the same additions in the same order as the dense loops (the same bits),
+    without the n^3 tests for zeros that were most of a prediction's cost (issue 16)."""
     n = P.shape[0]
-    FP = np.zeros((n, n))
+    columns = np.empty((n, n), dtype=np.int64)
+    counts = np.zeros(n, dtype=np.int64)
     for i in range(n):
         for k in range(n):
+            if F[i, k] != 0.0:
+                columns[i, counts[i]] = k
+                counts[i] += 1
+    FP = np.zeros((n, n))
+    for i in range(n):
+        for m in range(counts[i]):
+            k = columns[i, m]
             f = F[i, k]
-            if f != 0.0:
-                for j in range(n):
-                    FP[i, j] += f * P[k, j]
+            for j in range(n):
+                FP[i, j] += f * P[k, j]
     for i in range(n):
         for j in range(n):
             acc = 0.0
-            for k in range(n):
-                f = F[j, k]
-                if f != 0.0:
-                    acc += FP[i, k] * f
+            for m in range(counts[j]):
+                k = columns[j, m]
+                acc += FP[i, k] * F[j, k]
             P[i, j] = acc
 
 
