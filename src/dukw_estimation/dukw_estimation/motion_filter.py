@@ -110,6 +110,10 @@ class MotionFilter:
         self.yaw_set = False
         self.imu: ImuSample | None = None
         self.accel_base = (math.nan, math.nan, math.nan)   # specific force at base_link
+        # of the last IMU sample, worked out once when it came (read at every prediction
+        # step and contact decision): ``heave_accel_mps2``, ``gravity_free_accel``
+        self._heave_accel_mps2 = math.nan
+        self._gravity_free_mps2 = (math.nan, math.nan)
         self.tracks: DriveStatus | None = None
         self.props: DriveStatus | None = None
 
@@ -182,23 +186,24 @@ class MotionFilter:
     def heave_accel_mps2(self) -> float:
         """Vertical acceleration of base_link, m/s^2: the last IMU sample's specific force at
         base_link over the tilt, less g (NaN without an IMU sample)."""
-        imu, fz = self.imu, self.accel_base[2]
-        if imu is None or not math.isfinite(fz):
-            return math.nan
-        return _vertical_specific_force(imu, fz) - self.vehicle.body.gravity_mps2
+        return self._heave_accel_mps2
 
     def gravity_free_accel(self) -> tuple[float, float]:
         """The last IMU sample's surge and sway acceleration at base_link, m/s^2, gravity
         removed with its attitude (NaN without a sample with accelerations): gravity along
         the body axes from the attitude, scaled by the measured vertical specific force
         (heave accelerations afloat): g_up = f_z / (cos roll cos pitch)."""
+        return self._gravity_free_mps2
+
+    def _imu_accelerations(self) -> None:
+        """``heave_accel_mps2`` and ``gravity_free_accel`` of the sample just taken."""
         imu = self.imu
-        if imu is None:
-            return math.nan, math.nan
         fx, fy, fz = self.accel_base
         g_up = _vertical_specific_force(imu, fz)
-        return (fx + g_up * math.sin(imu.pitch_rad),
-                fy - g_up * math.sin(imu.roll_rad) * math.cos(imu.pitch_rad))
+        self._heave_accel_mps2 = g_up - self.vehicle.body.gravity_mps2 \
+            if math.isfinite(fz) else math.nan
+        self._gravity_free_mps2 = (fx + g_up * math.sin(imu.pitch_rad),
+                                   fy - g_up * math.sin(imu.roll_rad) * math.cos(imu.pitch_rad))
 
     def _drive_target(self, now: float, fraction: float) -> tuple[float, float, float] | None:
         st = self.settings
@@ -220,6 +225,7 @@ class MotionFilter:
         dt = s.t_s - self.imu.t_s if self.imu is not None else 0.0
         self.accel_base = self._accel_at_base_link(s, dt)
         self.imu = s
+        self._imu_accelerations()
         st = self.settings
         var = s.yaw_rate_var_rps2 if s.yaw_rate_var_rps2 > 0 else st.gyro_rps ** 2
         x = self.ekf.x
