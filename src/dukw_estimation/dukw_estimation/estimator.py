@@ -131,6 +131,13 @@ class Estimator:
         pushing = self.contact.tracks_pushing(motion.tracks, motion.fresh_now('tracks'))
         self.contact.refresh(self.ekf.x, imu_fresh, pushing)
 
+    def _contact_states(self) -> tuple[float, float, float]:
+        """The states the contact decision reads (``ContactModel.refresh``: the submersion
+        of s, eta and yaw): a heave update that moved none of them (on the sand after a
+        touchdown it corrects the heave alone) leaves the decision as it was."""
+        x = self.ekf.x
+        return x.item(_S), x.item(_ETA), x.item(_YAW)
+
     # ------------------------------------------------------------------ time
     def advance(self, t_s: float) -> None:
         """Predict the filter forward to ``t_s`` (no-op when ``t_s`` is not newer) and
@@ -175,8 +182,9 @@ class Estimator:
         heave = self.motion_filter.heave_accel_mps2()
         self.contact.observe_imu(s, heave, dt)
         self._refresh_contact()
+        before = self._contact_states()
         if self.heave.update(self.ekf, heave, self.motion_filter.position_set) \
-                is Outcome.ACCEPTED:
+                is Outcome.ACCEPTED and self._contact_states() != before:
             self._refresh_contact()
         self.contact.update_slope(s, self.ekf.x[Idx.YAW], dt)
         self._zero_velocity(s)
