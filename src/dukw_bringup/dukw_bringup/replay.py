@@ -111,16 +111,21 @@ class _Driver:
             t_s = self.next_tick_ns * 1e-9
             out = self.adapter.tick(t_s)
             if out is not None:
-                self.latest = out
-                self.rows.append({'t_s': t_s, **out})
+                self._keep(t_s, out)
             self.next_tick_ns += self.period_ns
 
     def feed(self, topic: str, t_ns: int, msg: Any) -> None:
         t_s = t_ns * 1e-9
         out = self.adapter.feed(topic, t_s, msg)
         if out is not None:
-            self.latest = out
-            self.rows.append({'t_s': t_s, **out})
+            self._keep(t_s, out)
+
+    def _keep(self, t_s: float, out: dict[str, float]) -> None:
+        """An output row, stamped: the adapter's own dict (a new one per output, its
+        contract), not a copy of it."""
+        out['t_s'] = t_s
+        self.latest = out
+        self.rows.append(out)
 
     def compare(self, topic: str, t_ns: int, msg: Any) -> None:
         """Note a recorded output and the latest replayed one (``settle`` compares)."""
@@ -353,7 +358,8 @@ def write_csv(rows: list[dict[str, float]], path: Path) -> None:
         path.write_text('')
         return
     with path.open('w', newline='') as handle:
-        writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
+        names = [name for name in rows[0] if name != 't_s']
+        writer = csv.DictWriter(handle, fieldnames=['t_s', *names])
         writer.writeheader()
         writer.writerows(rows)
 

@@ -52,7 +52,9 @@ class CoreAdapter(ABC):
         """An input message received at ``t_s`` (bag time, s): the tuple of its ``fields``
         (or the message).
 
-        Return an output when the node reacts at once (outside its timer), else None.
+        Return an output when the node reacts at once (outside its timer), else None. An
+        output (here and from ``tick``) is a new dict each time: the replay stamps it
+        (``t_s``) and keeps it as the row.
         """
 
     @abstractmethod

@@ -64,6 +64,9 @@ def test_ticks_follow_the_node_rate_anchored_on_the_first_output(tmp_path):
     assert [row['total'] for row in result.rows['sum']] == [3.0, 5.0, 7.0, 9.0]
     assert result.messages == 13
     assert result.exceeding({}, 1e-9) == []
+    replay_module.write_csv(result.rows['sum'], tmp_path / 'sum.csv')
+    lines = (tmp_path / 'sum.csv').read_text().splitlines()
+    assert lines[0] == 't_s,total,ticks' and lines[1] == '0.1,3.0,1.0'   # the time first
 
 
 def test_a_moved_output_is_named_with_its_size_and_time(tmp_path):
