@@ -229,11 +229,7 @@ class Estimator:
         """A valid sounding means the transducer floats above the sea bed: corrects s, eta."""
         if not s.valid:
             rejected = self._admit('depth', s.t_s, ())
-            if rejected:
-                return rejected
-            if self.settings.sounder_sand_bound and not self.contact.afloat:
-                self.surface.bound_by_sounder(self.ekf, valid=False)
-            return self._settle('depth', Outcome.IGNORED)
+            return rejected or self._settle('depth', Outcome.IGNORED)
         rejected = self._admit('depth', s.t_s, (s.depth_m,))
         return rejected or self._settle('depth', self.surface.depth(self.ekf, s))
 

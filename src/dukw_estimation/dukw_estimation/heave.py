@@ -37,7 +37,6 @@ from dukw_estimation.settings import EkfSettings
 #: depth step of the level hulls' volume table, m (the section's area is smooth on this scale)
 TABLE_STEP_M = 0.001
 _S, _ETA, _HEAVE, _HEAVE_RATE = int(Idx.S), int(Idx.ETA), int(Idx.HEAVE), int(Idx.HEAVE_RATE)
-_ETA_RATE = int(Idx.ETA_RATE)
 
 
 class HeaveObserver:
@@ -67,8 +66,6 @@ class HeaveObserver:
         self.surface_updates = 0
         self.ground_updates = 0
         self.last_accel_mps2 = math.nan  # the last heave acceleration short of an impact
-        self.last_heave_rate_mps = math.nan   # ... and the heave rate then
-        self.rate_ties = 0               # wave rates tied to the heave rate at a touchdown
         self.impact_drafts = 0           # drafts measured when the sand struck the keel
         self.held_at_beach = 0           # afloat, drafts asking for more water at the beach
 
@@ -97,22 +94,12 @@ class HeaveObserver:
         if not placed:
             return Outcome.IGNORED
         impact = self.contact.impact(heave_accel_mps2)
-        floated, rate_before = self.last_accel_mps2, self.last_heave_rate_mps
+        floated = self.last_accel_mps2
         if not impact:
             self.last_accel_mps2 = heave_accel_mps2
-            self.last_heave_rate_mps = float(ekf.x[_HEAVE_RATE])
-        elif math.isfinite(floated):
-            if self._afloat(ekf, floated, at_impact=True) is Outcome.ACCEPTED:
-                self.impact_drafts += 1
-            sigma = self.settings.heave_touchdown_rate_mps
-            self.last_heave_rate_mps = math.nan      # the rate once per landing
-            if sigma > 0.0 and math.isfinite(rate_before):
-                h = np.zeros(N_STATES)
-                h[_ETA_RATE] = 1.0
-                if ekf.update_scalar(rate_before, float(ekf.x[_ETA_RATE]), h, sigma * sigma,
-                                     self.settings.heave_gate, only=WAVE_HEAVE_STATES) \
-                        is Outcome.ACCEPTED:
-                    self.rate_ties += 1
+        elif math.isfinite(floated) and self._afloat(ekf, floated, at_impact=True) \
+                is Outcome.ACCEPTED:
+            self.impact_drafts += 1
         if self.contact.afloat:
             self.was_afloat = True
             return self._afloat(ekf, heave_accel_mps2)

@@ -106,11 +106,6 @@ class EkfSettings:
     wave_damping_ratio: float = _f('wave.damping_ratio', 'oscillator damping (sea bandwidth)',
                                    0.01, 2)
     wave_sigma_m: float = _f('wave.sigma_m', 'wave elevation sigma, ~ H1/3 / 4', 0, 2)
-    wave_celerity_depth_m: float = _f(
-        'wave.celerity_depth_m', 'the waves travel shoreward at the linear phase speed of '
-        'wave.peak_frequency_hz in water this deep: a point d m seaward of base_link sees the '
-        'surface d / c s earlier (a wet/dry sensor reads eta + d / c x its rate); 0: the '
-        'surface level over the hulls', 0, 100)
     heave_natural_hz: float = _f('seakeeping.heave_natural_hz',
                                  'heave natural frequency afloat (vehicle.md 5: 0.5731)', 0.01, 10)
     heave_damping_ratio: float = _f('seakeeping.heave_damping_ratio',
@@ -124,9 +119,6 @@ class EkfSettings:
     heave_ground_m: float = _f('heave.ground_sigma_m', 'on the sand: the keel on the beach, '
                                'sigma', 1e-4, 1)
     heave_gate: float = _f('heave.mahalanobis', 'rejection distance of both', 0.5, 1e6)
-    heave_touchdown_rate_mps: float = _f(
-        'heave.touchdown_rate_sigma_mps', "at a touchdown the wave's rate is the floating "
-        "hull's heave rate of the sample before, this sigma (0: not used)", 0, 10)
     heave_keel_at_beach_m: float = _f('heave.keel_at_beach_m', 'afloat, the keel this close '
                                       'to the estimated beach may lie on it: the dynamic draft '
                                       'then bounds the water from above only (0: off)', 0, 1)
@@ -232,15 +224,6 @@ class EkfSettings:
         'contact.bracket_period_s', 'one water sensor wet, the other dry: the surface as '
         "anywhere between their heights (the span's middle, sigma width / sqrt(12)), at most "
         'this often (0: off)', 0, 60)
-    contact_flip_update: bool = _f(
-        'contact.flip_update', 'on the sand a wet/dry flag that has just changed puts the '
-        "surface at its sensor (noise.contact_m and the sea's slope), whatever the state "
-        'says: the surface crossed it since the last reading')
-    sounder_sand_bound: bool = _f(
-        'contact.sounder_bound', 'on the sand a valid sounding bounds the water at the '
-        "transducer from below by the sounder's minimum depth (sensors.depth_sounder_min_m): "
-        'the surface states are projected onto that bound; the sounding itself (the '
-        "transducer's height over the sand) is no floating draft")
     water_dry_bound: bool = _f(
         'contact.dry_bound', 'both water sensors reading dry bound the surface below them: '
         'the surface states are projected onto that bound (a constraint, which confident '

@@ -13,7 +13,7 @@ from dataclasses import replace
 import numpy as np
 
 from dukw_common.vehicle import Vehicle
-from dukw_model import seakeeping, traction
+from dukw_model import traction
 from dukw_estimation.contact import ContactModel, ground_speeds
 from dukw_estimation.ekf import (N_STATES, SURFACE_STATES, WATER_SURFACE_STATES, WATERLINE_STATE,
                                  Idx, MotionEkf, Outcome)
@@ -32,12 +32,6 @@ class SurfaceObserver:
         self.vehicle = vehicle
         self.settings = settings
         self.contact = contact
-        #: s per metre seaward: the waves run shoreward at the celerity of the configured sea
-        #: (``wave.celerity_depth_m``; 0: the surface level over the hulls)
-        depth = settings.wave_celerity_depth_m
-        self.lead_s_per_m = 1.0 / seakeeping.wave_celerity_mps(
-            settings.wave_peak_frequency_hz, depth, vehicle.body.gravity_mps2) \
-            if depth > 0.0 else 0.0
         self.reset()
 
     def reset(self) -> None:
@@ -47,34 +41,22 @@ class SurfaceObserver:
         self.dry_sensors: tuple[tuple[float, float], ...] = ()   # (x, z): both read dry
         self.dry_t_s = -math.inf                                 # ... at this time
         self.bracket_t_s = -math.inf     # the last update from one sensor wet, one dry
-        self.last_wet: tuple[bool, bool] | None = None   # the last (fore, aft) flags
-        self.flip_updates = 0            # flags that changed on the sand: surface at them
 
     # ------------------------------------------------------------------ wet / dry
     def water_contact(self, ekf: MotionEkf, s: WaterContact) -> Outcome:
-        """Wet/dry sensors: where the state disagrees, the surface is at the sensor; and where
-        a flag has just changed (``contact.flip_update``), whatever the state says: the
-        surface crossed the sensor between this reading and the last (event-based
-        estimation: a threshold sensor's change is a measurement of the crossing, not only a
-        bound on each side of it). Issue 18: on the sand in the surf nothing else tells the
-        wave's fall or rise at the hulls between the track forces."""
+        """Wet/dry sensors: where the state disagrees, the surface is at the sensor."""
         self.dry_sensors = ()
-        last, self.last_wet = self.last_wet, (bool(s.fore_wet), bool(s.aft_wet))
         if self.contact.afloat:
             # floating, the sensors ride with the hull, not at a height above the sand
             return Outcome.ACCEPTED
         mounts = self.vehicle.sensors
         sensors = ((s.fore_wet, mounts.fore_water_x_m, mounts.fore_water_z_m),
                    (s.aft_wet, mounts.aft_water_x_m, mounts.aft_water_z_m))
-        flips = (False, False) if last is None or not self.settings.contact_flip_update \
-            else tuple(bool(new) != old for new, old in zip(self.last_wet, last, strict=True))
         out = Outcome.IGNORED
-        for (wet, x_m, z_m), flip in zip(sensors, flips, strict=True):
+        for wet, x_m, z_m in sensors:
             depth, h = self._sensor_depth(ekf.x, x_m, z_m)
-            if bool(wet) == (depth > 0.0) and not flip:
+            if bool(wet) == (depth > 0.0):
                 continue
-            if flip:
-                self.flip_updates += 1
             result = ekf.update_scalar(0.0, depth, h, self.contact_variance_m2(x_m),
                                        self.settings.gate_water, only=SURFACE_STATES)
             self.clip_soil_scale(ekf)
@@ -132,7 +114,7 @@ class SurfaceObserver:
         if self.contact.afloat or t_s - self.dry_t_s > self.settings.sensor_timeout_s:
             return
         for x_m, z_m in self.dry_sensors:
-            depth, h = self._sensor_depth(ekf.x, x_m, z_m, ahead=False)
+            depth, h = self._sensor_depth(ekf.x, x_m, z_m)
             if depth <= 0.0:
                 continue
             h_surface = h * SURFACE_STATES
@@ -142,64 +124,21 @@ class SurfaceObserver:
                 ekf.x -= SURFACE_STATES * p_h * (depth / spread)
                 self.clip_soil_scale(ekf)
 
-    def bound_by_sounder(self, ekf: MotionEkf, valid: bool = True) -> None:
-        """A valid sounding on the sand: the sounder echoes only with more than
-        ``sensors.depth_sounder_min_m`` of water (vehicle.md 2: about 0.5 m), so the water over
-        the sand at the transducer is at least that; what it reads, the transducer's height
-        over the sand, says nothing of the surface. Where the state has less water there,
-        project the surface states onto the bound (as ``bound_by_dry_sensors``: the
-        covariance-weighted least change). Issue 18: on the sand in the surf the valid
-        soundings came with 0.51-0.54 m of water at base_link on average while the estimate
-        had 0.37-0.49 m, read as a floating hull's draft that moved s alone by sigma 0.15 m."""
-        x, mounts = ekf.x, self.vehicle.sensors
-        sin_t = math.sin(self.contact.slope_rad)
-        rel = x[Idx.YAW] - self.settings.seaward_yaw_rad
-        water = x[Idx.ETA] + (x[Idx.S] + mounts.depth_sounder_x_m * math.cos(rel)) * sin_t
-        short = mounts.depth_sounder_min_m - water
-        if (short <= 0.0) if valid else (short >= 0.0):
-            return
-        h = np.zeros(N_STATES)
-        h[Idx.ETA] = 1.0
-        h[Idx.S] = sin_t
-        h_water = h * WATER_SURFACE_STATES
-        p_h = ekf.P @ h_water
-        spread = float(h_water @ p_h)
-        if spread > 0.0:
-            ekf.x += WATER_SURFACE_STATES * p_h * (short / spread)
-
-    def _sensor_depth(self, x: np.ndarray, x_m: float, z_m: float, ahead: bool = True
-                      ) -> tuple[float, np.ndarray]:
-        """Water over a sensor at body (x, z) of a vehicle on the slope, and its Jacobian.
-
-        The waves run shoreward: a sensor d m seaward of base_link sees the surface that
-        reaches base_link d / c s later, eta + (d / c) deta/dt (``lead_s_per_m`` = 1 / c;
-        issue 18: the sensors' surface less base_link's follows it with correlation
-        0.7-0.96 in the campaign's surf), so a sensor's crossing also tells the wave's rate."""
+    def _sensor_depth(self, x: np.ndarray, x_m: float, z_m: float) -> tuple[float, np.ndarray]:
+        """Water over a sensor at body (x, z) of a vehicle on the slope, and its Jacobian."""
         slope = self.contact.slope_rad
         sin_t, cos_t = math.sin(slope), math.cos(slope)
         rel = x[Idx.YAW] - self.settings.seaward_yaw_rad
-        seaward = x_m * math.cos(rel)
-        depth = x[Idx.ETA] + (x[Idx.S] + seaward) * sin_t - z_m * cos_t
+        depth = x[Idx.ETA] + (x[Idx.S] + x_m * math.cos(rel)) * sin_t - z_m * cos_t
         h = np.zeros(N_STATES)
         h[Idx.ETA] = 1.0
         h[Idx.S] = sin_t
         h[Idx.YAW] = -x_m * math.sin(rel) * sin_t
-        lead = self.lead_s_per_m
-        if ahead and lead > 0.0:
-            ahead_s = seaward * cos_t * lead
-            depth += ahead_s * x[Idx.ETA_RATE]
-            h[Idx.ETA_RATE] = ahead_s
-            h[Idx.YAW] -= x_m * math.sin(rel) * cos_t * lead * x[Idx.ETA_RATE]
         return depth, h
 
     # ------------------------------------------------------------------ sounder
     def depth(self, ekf: MotionEkf, s: DepthReading) -> Outcome:
-        """A valid sounding means the transducer floats above the sea bed: corrects s, eta.
-        On the sand (``contact.sounder_bound``) it is no floating draft: see
-        ``bound_by_sounder``."""
-        if self.settings.sounder_sand_bound and not self.contact.afloat:
-            self.bound_by_sounder(ekf)
-            return Outcome.ACCEPTED
+        """A valid sounding means the transducer floats above the sea bed: corrects s, eta."""
         x = ekf.x
         body, mounts, site = self.vehicle.body, self.vehicle.sensors, self.vehicle.site
         sin_t = math.sin(self.contact.slope_rad)

@@ -483,49 +483,6 @@ def test_a_wet_dry_sensor_reads_the_surface_at_its_end_of_the_hulls():
     assert 0.0 < shifts[slope] < 0.8 * shifts[0.0]
 
 
-def test_a_wet_dry_sensor_seaward_reads_the_wave_that_is_coming():
-    """The waves run shoreward at the configured sea's celerity c (wave.celerity_depth_m):
-    a sensor d m seaward of base_link reads the surface base_link sees d / c s later, eta +
-    (d / c) deta/dt. So on a rising wave the seaward sensor is wetter than a level surface
-    says, the landward one drier, and a crossing at either tells the wave's rate too
-    (issue 18: on the sand nothing else observes it). Off (0): the level surface."""
-    from dukw_model.seakeeping import wave_celerity_mps
-    depth = 0.76
-    c = wave_celerity_mps(SETTINGS.wave_peak_frequency_hz, depth, G)
-    fore, aft = VEHICLE.sensors.fore_water_x_m, VEHICLE.sensors.aft_water_x_m
-    z = VEHICLE.sensors.fore_water_z_m
-    rate = 0.2
-    for yaw, seaward_sign in ((SETTINGS.seaward_yaw_rad, 1.0),
-                              (SETTINGS.seaward_yaw_rad + math.pi, -1.0)):
-        level, ahead = make(wave_celerity_depth_m=0.0), make(wave_celerity_depth_m=depth)
-        assert ahead.surface.lead_s_per_m == pytest.approx(1.0 / c)
-        assert level.surface.lead_s_per_m == 0.0
-        for est in (level, ahead):
-            est.ekf.x[Idx.YAW] = yaw
-            est.ekf.x[Idx.S], est.ekf.x[Idx.ETA], est.ekf.x[Idx.ETA_RATE] = -1.0, 0.05, rate
-        cos_t = math.cos(ahead.contact.slope_rad)
-        for x_m in (fore, aft):
-            flat, h_flat = level.surface._sensor_depth(level.ekf.x, x_m, z)
-            wave, h = ahead.surface._sensor_depth(ahead.ekf.x, x_m, z)
-            lead_s = seaward_sign * x_m * cos_t / c
-            assert wave - flat == pytest.approx(lead_s * rate)
-            assert h[Idx.ETA_RATE] == pytest.approx(lead_s)
-            assert h_flat[Idx.ETA_RATE] == 0.0
-    # on the sand, the seaward (fore) sensor reads wet where the level surface is below it:
-    # the update raises the wave's rate, not only its level
-    est = make(wave_celerity_depth_m=depth)
-    est.ekf.x[Idx.S], est.ekf.x[Idx.ETA], est.ekf.x[Idx.ETA_RATE] = -3.0, 0.0, 0.0
-    surface = [Idx.S, Idx.ETA, Idx.ETA_RATE]
-    est.ekf.P[surface, :] = 0.0
-    est.ekf.P[:, surface] = 0.0
-    est.ekf.P[Idx.S, Idx.S], est.ekf.P[Idx.ETA, Idx.ETA] = 0.5 ** 2, 0.05 ** 2
-    est.ekf.P[Idx.ETA_RATE, Idx.ETA_RATE] = 0.1 ** 2
-    est.surface.bracket_t_s = 0.5
-    est.surface.water_contact(est.ekf, WaterContact(1.0, True, False))
-    assert est.ekf.x[Idx.ETA_RATE] > 0.0
-    assert est.ekf.x[Idx.ETA] > 0.0
-
-
 def test_a_weaker_beach_is_learnt_as_the_soils_factor_not_read_as_water():
     """On a beach weaker than the configured soil (the paper's 64 % fit), met in the surf with
     no dry sand to learn it first, the tracks' force is short of the configured model's:

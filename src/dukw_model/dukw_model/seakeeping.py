@@ -50,22 +50,3 @@ def heave_constants(body: VehicleParams, natural_hz: float,
     stiffness = body.water_density_kgpm3 * body.gravity_mps2 * waterplane_m2
     mass_kg, damping = oscillator_constants(stiffness, natural_hz, damping_ratio)
     return HeaveConstants(stiffness, mass_kg, damping)
-
-
-def wave_celerity_mps(frequency_hz: float, depth_m: float, gravity_mps2: float) -> float:
-    """Phase speed of a linear (Airy) wave of ``frequency_hz`` in water ``depth_m`` deep,
-    m/s: the dispersion omega^2 = g k tanh(k h) solved for k by Newton's method, c = omega/k
-    (Dean and Dalrymple, Water Wave Mechanics, 1991, ch. 3; sqrt(g h) in shallow water)."""
-    if frequency_hz <= 0.0 or depth_m <= 0.0 or gravity_mps2 <= 0.0:
-        raise ValueError('wave_celerity_mps needs a positive frequency, depth and gravity')
-    omega = 2.0 * math.pi * frequency_hz
-    k = omega / math.sqrt(gravity_mps2 * depth_m)          # the shallow-water start
-    for _ in range(50):
-        t = math.tanh(k * depth_m)
-        f = gravity_mps2 * k * t - omega * omega
-        df = gravity_mps2 * (t + k * depth_m * (1.0 - t * t))
-        step = f / df
-        k -= step
-        if abs(step) < 1e-12 * k:
-            break
-    return omega / k

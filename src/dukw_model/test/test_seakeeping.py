@@ -6,8 +6,7 @@ import pytest
 from dukw_common.config import shared_params
 from dukw_common.vehicle import Vehicle
 from dukw_model.buoyancy import HullSection
-from dukw_model.seakeeping import (heave_constants, heave_waterplane_m2, oscillator_constants,
-                                   wave_celerity_mps)
+from dukw_model.seakeeping import heave_constants, heave_waterplane_m2, oscillator_constants
 
 PARAMS = shared_params()
 BODY = Vehicle.load().body
@@ -36,16 +35,3 @@ def test_heave_constants_from_the_shared_facts():
 def test_bad_oscillator_facts_are_refused(args):
     with pytest.raises(ValueError):
         oscillator_constants(*args)
-
-
-def test_wave_celerity_from_the_linear_dispersion():
-    """The phase speed solves omega^2 = g k tanh(k h): the paper's Froude-Krylov case (4.88 s
-    waves in 0.76 m, vehicle.md 5) is 13 m long; shallow water runs at sqrt(g h), deep water
-    at g / omega; a shallower sea is slower."""
-    g = 9.81
-    assert wave_celerity_mps(1.0 / 4.88, 0.76, g) * 4.88 == pytest.approx(13.0, abs=0.1)
-    assert wave_celerity_mps(0.01, 0.3, g) == pytest.approx(math.sqrt(g * 0.3), rel=1e-3)
-    assert wave_celerity_mps(2.0, 50.0, g) == pytest.approx(g / (2 * math.pi * 2.0), rel=1e-6)
-    assert wave_celerity_mps(0.28, 0.3, g) < wave_celerity_mps(0.28, 0.76, g)
-    with pytest.raises(ValueError):
-        wave_celerity_mps(0.28, 0.0, g)
