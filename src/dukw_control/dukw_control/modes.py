@@ -44,8 +44,8 @@ NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
     ('land_enter_fraction', 'weight on tracks above this, sensors dry: land', 0.0, 1.0),
     ('water_enter_fraction', 'weight on tracks below this, force at friction: water', 0.0, 1.0),
     ('water_exit_fraction', 'weight on tracks above this afloat: transition', 0.0, 1.0),
-    ('water_needs_estimated_afloat', "transition -> water only while the estimator's "
-     'afloat / on-the-sand decision says afloat', None, None),
+    ('water_needs_estimated_afloat', "transition -> water's debounce starts only when the "
+     "estimator's afloat / on-the-sand decision says afloat", None, None),
     ('resting_fraction', 'afloat, a mean weight on tracks above this: resting on the ground',
      0.0, 1.0),
     ('resting_time_constant_s', 'low-pass of the weight on tracks for resting_fraction, s',
@@ -95,7 +95,7 @@ class ModeSettings:
     land_enter_fraction: float        # back above this (and both sensors dry): on land
     water_enter_fraction: float       # below this (and force at friction): afloat
     water_exit_fraction: float        # back above this: the tracks carry weight again
-    water_needs_estimated_afloat: bool  # ... and the estimator's contact decision afloat
+    water_needs_estimated_afloat: bool  # ... its count started by the estimator's afloat
     resting_fraction: float           # or its mean above this: resting on the ground
     resting_time_constant_s: float    # the mean's low-pass (over the waves' heave)
     friction_force_n: float           # per-track force at or below drivetrain friction
