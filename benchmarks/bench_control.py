@@ -40,7 +40,7 @@ def main() -> None:
     def mode_cycle(k):
         t = k * 0.05
         manager.on_water_contact(k % 40 < 5, False, t)
-        manager.on_traction(0.9 if k % 40 < 5 else 1.0, t)
+        manager.on_traction(0.9 if k % 40 < 5 else 1.0, False, t)
         manager.on_track_forces(150.0, 160.0, t)
         manager.update(t)
 

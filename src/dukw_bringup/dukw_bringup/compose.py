@@ -130,7 +130,8 @@ def estimate_handoff(ekf: Node, mode_manager: Node | None, controller: Node | No
             controller.runner.on_traction(traction.port_slip, traction.stbd_slip,
                                          traction.weight_on_tracks_fraction, now)
         if mode_manager is not None:
-            mode_manager.runner.on_traction(traction.weight_on_tracks_fraction, now)
+            mode_manager.runner.on_traction(traction.weight_on_tracks_fraction,
+                                            traction.afloat, now)
     return on_estimate
 
 

@@ -111,7 +111,7 @@ class ModeManagerAdapter(CoreAdapter):
     outputs = ('drive_mode',)
     fields = MappingProxyType({
         'water/contact': ('fore_wet', 'aft_wet'), 'depth': ('valid', 'depth_m'),
-        'traction': ('weight_on_tracks_fraction',),
+        'traction': ('weight_on_tracks_fraction', 'afloat'),
         'tracks/status': ('connected', 'port.force_n', 'stbd.force_n'),
         'imu/data': STAMP_FIELDS,
         'drive_mode': ('mode', 'automatic', 'track_weight', 'prop_weight', 'tracks_idle')})
@@ -136,7 +136,7 @@ class ModeManagerAdapter(CoreAdapter):
         return {
             'water/contact': lambda v, t_s: r.on_water_contact(v[0], v[1], t_s),
             'depth': lambda v, t_s: r.on_depth(v[0], v[1], t_s),
-            'traction': lambda v, t_s: r.on_traction(v[0], t_s),
+            'traction': lambda v, t_s: r.on_traction(v[0], v[1], t_s),
             'tracks/status': lambda v, t_s: r.on_track_status(v[0], v[1], v[2], t_s),
             'imu/data': lambda v, t_s: r.on_imu(stamp_s_or(v[0], v[1], t_s), t_s)}
 

@@ -171,7 +171,8 @@ class Stack:
             odom.surge_mps, odom.yaw_rate_rps, odom.pitch_rad, t_ns * 1e-9))
 
     def _traction(self, topic: str, t_ns: int, traction: TractionEstimate) -> None:
-        self.mode_manager.on_traction(traction.weight_on_tracks_fraction, t_ns * 1e-9)
+        self.mode_manager.on_traction(traction.weight_on_tracks_fraction, traction.afloat,
+                                      t_ns * 1e-9)
         self.controller.on_traction(traction.port_slip, traction.stbd_slip,
                                     traction.weight_on_tracks_fraction, t_ns * 1e-9)
 

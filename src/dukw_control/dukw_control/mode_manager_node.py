@@ -70,7 +70,7 @@ class ModeManagerNode(Node):
         self.runner.on_depth(msg.valid, msg.depth_m, self.now_s())
 
     def on_traction(self, msg: Traction) -> None:
-        self.runner.on_traction(msg.weight_on_tracks_fraction, self.now_s())
+        self.runner.on_traction(msg.weight_on_tracks_fraction, msg.afloat, self.now_s())
 
     def on_tracks(self, msg: DrivetrainStatus) -> None:
         self.runner.on_track_status(msg.connected, msg.port.force_n, msg.stbd.force_n,

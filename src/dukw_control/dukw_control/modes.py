@@ -44,6 +44,8 @@ NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
     ('land_enter_fraction', 'weight on tracks above this, sensors dry: land', 0.0, 1.0),
     ('water_enter_fraction', 'weight on tracks below this, force at friction: water', 0.0, 1.0),
     ('water_exit_fraction', 'weight on tracks above this afloat: transition', 0.0, 1.0),
+    ('water_needs_estimated_afloat', "transition -> water's debounce starts only when the "
+     "estimator's afloat / on-the-sand decision says afloat", None, None),
     ('resting_fraction', 'afloat, a mean weight on tracks above this: resting on the ground',
      0.0, 1.0),
     ('resting_time_constant_s', 'low-pass of the weight on tracks for resting_fraction, s',
@@ -74,11 +76,14 @@ NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
 )
 
 
+_BOOL_SETTINGS = ('water_tracks_idle', 'water_needs_estimated_afloat')
+
+
 def settings_from_params(params: Mapping[str, ParamValue]) -> 'ModeSettings':
     """Build ModeSettings from dotted parameters (mode_manager_node block)."""
     values = {}
     for name in ModeSettings.__dataclass_fields__:
-        values[name] = require(params, name, bool if name == 'water_tracks_idle' else float)
+        values[name] = require(params, name, bool if name in _BOOL_SETTINGS else float)
     return ModeSettings(**values)
 
 
@@ -90,6 +95,7 @@ class ModeSettings:
     land_enter_fraction: float        # back above this (and both sensors dry): on land
     water_enter_fraction: float       # below this (and force at friction): afloat
     water_exit_fraction: float        # back above this: the tracks carry weight again
+    water_needs_estimated_afloat: bool  # ... its count started by the estimator's afloat
     resting_fraction: float           # or its mean above this: resting on the ground
     resting_time_constant_s: float    # the mean's low-pass (over the waves' heave)
     friction_force_n: float           # per-track force at or below drivetrain friction
@@ -170,6 +176,11 @@ class Debounce:
         """Forget how long the condition has held."""
         self._since = None
 
+    @property
+    def running(self) -> bool:
+        """The condition holds and is being timed."""
+        return self._since is not None
+
 
 class ModeManager:
     """Feed it inputs (``on_*``) and call ``update(now_s)`` at a fixed rate."""
@@ -182,6 +193,7 @@ class ModeManager:
         self.props_in_swash = False      # LAND, yet the props still push (land_prop_hold_s)
         self.depth_valid = False
         self.weight_fraction = 1.0
+        self.estimated_afloat = False    # the estimator's afloat / on-the-sand decision
         self.mean_weight_fraction = 1.0  # low-passed (resting_time_constant_s)
         self.track_force_n = 0.0         # low-passed max of |port|, |stbd|
         self.rejected = 0
@@ -209,13 +221,15 @@ class ModeManager:
         self.depth_valid = bool(valid) and math.isfinite(depth_m) and depth_m > 0.0
         self._stamps['depth'] = now_s
 
-    def on_traction(self, weight_on_tracks_fraction: float, now_s: float) -> bool:
-        """The estimator's fraction of the weight on the tracks; False if rejected (NaN)."""
+    def on_traction(self, weight_on_tracks_fraction: float, afloat: bool, now_s: float) -> bool:
+        """The estimator's fraction of the weight on the tracks and its afloat / on-the-sand
+        decision; False if rejected (NaN)."""
         f = weight_on_tracks_fraction
         if not math.isfinite(f):
             self.rejected += 1
             return False
         self.weight_fraction = min(max(f, 0.0), 1.0)
+        self.estimated_afloat = bool(afloat)
         self.mean_weight_fraction = self._low_pass(
             self.mean_weight_fraction, self.weight_fraction, self.s.resting_time_constant_s,
             self._stamps.get('traction'), now_s)
@@ -320,14 +334,32 @@ class ModeManager:
         return self.depth_valid and self.input_ages(now_s)['depth'] <= self.s.depth_timeout_s
 
     def _classify(self) -> tuple[Mode, str]:
-        """The mode the evidence shows at once (start-up, recovery, release)."""
+        """The mode the evidence shows at once (start-up, recovery, release). Without the
+        estimator's contact decision: at start-up its IMU motion test has no history yet
+        (it reads a hull lying still), so a hull started afloat would be called grounded."""
         f = self.weight_fraction
-        if f < self.s.water_enter_fraction and self.track_force_n <= self.s.friction_force_n \
-                and (self.depth_valid or (self.fore_wet and self.aft_wet)):
+        if self._afloat_evidence(self.depth_valid, True):
             return Mode.WATER, f'afloat (weight on tracks {f:.2f})'
         if self.fore_wet or self.aft_wet or f < self.s.transition_enter_fraction:
             return Mode.TRANSITION, f'in the surf (weight on tracks {f:.2f}, {self._wet_text()})'
         return Mode.LAND, f'on land (weight on tracks {f:.2f}, sensors dry)'
+
+    def _afloat_evidence(self, depth_ok: bool, started: bool) -> bool:
+        """Afloat: little weight on the tracks, their force at drivetrain friction, water
+        under the sounder or over both sensors, and (``water_needs_estimated_afloat``) the
+        estimator's own contact decision afloat when the count starts (``started``: it
+        has, and the rest still holds). The weight share is read from the estimated surface,
+        which lags a receding wave by up to a second; the contact decision comes from the IMU
+        (a floating hull rolls, pitches and heaves with the waves, one on the sand lies still)
+        or from water deep enough to float it beyond doubt, and so tells a hull the receding
+        water has set down on the sand from one it still carries. It starts the count but
+        need not hold it: in a long, low sea a floating hull's motion comes and goes about
+        the motion test's threshold with each wave."""
+        s = self.s
+        return (self.weight_fraction < s.water_enter_fraction
+                and self.track_force_n <= s.friction_force_n
+                and (depth_ok or (self.fore_wet and self.aft_wet))
+                and (self.estimated_afloat or started or not s.water_needs_estimated_afloat))
 
     def _wet_text(self) -> str:
         wet = [n for n, w in (('fore', self.fore_wet), ('aft', self.aft_wet)) if w]
@@ -381,7 +413,6 @@ class ModeManager:
         dwell_s = now_s - self._since_s
         dwell_done = dwell_s >= s.min_dwell_s
         wet_any = self.fore_wet or self.aft_wet
-        force_low = self.track_force_n <= s.friction_force_n
         if self._mode == Mode.LAND:
             wet = self._to_transition.update(wet_any or f < s.transition_enter_fraction, now_s)
             if wet and dwell_done:
@@ -390,8 +421,7 @@ class ModeManager:
                             f'weight on tracks {f:.2f})')
         elif self._mode == Mode.TRANSITION:
             afloat = self._to_water.update(
-                f < s.water_enter_fraction and force_low and (
-                    self._depth_ok(now_s) or (self.fore_wet and self.aft_wet)), now_s)
+                self._afloat_evidence(self._depth_ok(now_s), self._to_water.running), now_s)
             dry = self._to_land.update(
                 not wet_any and f > s.land_enter_fraction, now_s,
                 s.ashore_enter_land_s if self._previous == Mode.WATER else None)

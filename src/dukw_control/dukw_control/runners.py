@@ -64,8 +64,8 @@ class ModeManagerRunner:
     def on_depth(self, valid: bool, depth_m: float, now_s: float) -> None:
         self.core.on_depth(valid, depth_m, now_s)
 
-    def on_traction(self, weight_on_tracks_fraction: float, now_s: float) -> None:
-        self.core.on_traction(weight_on_tracks_fraction, now_s)
+    def on_traction(self, weight_on_tracks_fraction: float, afloat: bool, now_s: float) -> None:
+        self.core.on_traction(weight_on_tracks_fraction, afloat, now_s)
 
     def on_track_status(self, connected: bool, port_force_n: float, stbd_force_n: float,
                         now_s: float) -> None:

@@ -17,13 +17,16 @@ class Feed:
         self.modes = []
 
     def run(self, seconds, fraction=1.0, fore=False, aft=False, depth=False, force_n=200.0,
-            imu=True):
+            imu=True, afloat=None):
+        """``afloat``: the estimator's contact decision (None: afloat when nothing lies on
+        the tracks, fraction 0)."""
+        afloat = fraction <= 0.0 if afloat is None else afloat
         for _ in range(int(round(seconds / DT))):
             self.t += DT
             if imu:
                 self.mm.on_attitude(self.t, self.t)
             self.mm.on_water_contact(fore, aft, self.t)
-            self.mm.on_traction(fraction, self.t)
+            self.mm.on_traction(fraction, afloat, self.t)
             self.mm.on_track_forces(force_n, force_n, self.t)
             self.mm.on_depth(depth, 1.0 if depth else float('nan'), self.t)
             d = self.mm.update(self.t)
@@ -97,7 +100,7 @@ def test_stale_input_gives_safe_stop_with_the_reason_and_recovers(mode_settings)
 
 def test_nan_weight_fraction_is_rejected(mode_settings):
     mm = ModeManager(mode_settings)
-    assert not mm.on_traction(float('nan'), 0.0)
+    assert not mm.on_traction(float('nan'), True, 0.0)
     assert mm.rejected == 1 and mm.weight_fraction == 1.0
 
 
@@ -290,3 +293,39 @@ def test_a_resting_fraction_outside_the_hysteresis_is_refused(mode_settings):
     with pytest.raises(ValueError, match='resting_fraction'):
         ModeSettings(**{**dataclasses.asdict(mode_settings),
                         'resting_fraction': mode_settings.water_exit_fraction + 0.1})
+
+
+def test_water_waits_for_the_estimator_to_say_afloat(mode_settings):
+    """A receding wave leaves the estimated surface high (share near 0) over a hull the water
+    has set down on the sand, lying still: the estimator's contact decision says the sand, and
+    the mode stays in TRANSITION until it says afloat (issue 18, campaign runs 122, 139)."""
+    s = mode_settings
+    assert s.water_needs_estimated_afloat
+    f = Feed(s)
+    f.run(1.0, fraction=0.5, fore=True)
+    f.run(s.min_dwell_s, fraction=0.5, fore=True, aft=True)
+    f.run(3.0, fraction=0.0, fore=True, aft=True, force_n=10.0, afloat=False)
+    assert f.mm.mode == Mode.TRANSITION
+    f.run(s.enter_water_s - 0.1, fraction=0.0, fore=True, aft=True, force_n=10.0, afloat=True)
+    assert f.mm.mode == Mode.TRANSITION           # debounced from the first afloat decision
+    f.run(0.2, fraction=0.0, fore=True, aft=True, force_n=10.0, afloat=True)
+    assert [m for m, *_ in f.modes] == [Mode.TRANSITION, Mode.WATER]
+
+
+def test_without_the_estimator_afloat_rule_the_share_alone_decides(mode_settings):
+    s = dataclasses.replace(mode_settings, water_needs_estimated_afloat=False)
+    f = Feed(s)
+    f.run(1.0, fraction=0.5, fore=True)
+    f.run(s.min_dwell_s, fraction=0.5, fore=True, aft=True)
+    f.run(s.enter_water_s + 1.0, fraction=0.0, fore=True, aft=True, force_n=10.0,
+          afloat=False)
+    assert f.mm.mode == Mode.WATER
+
+
+
+def test_start_up_afloat_does_not_wait_for_the_estimator(mode_settings):
+    """At start-up the estimator's motion test has no history (a hull lying still): the
+    evidence of water alone classifies, as before the contact decision was heard."""
+    f = Feed(mode_settings)
+    f.run(0.1, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0, afloat=False)
+    assert f.mm.mode == Mode.WATER
