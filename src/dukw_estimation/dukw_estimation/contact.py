@@ -173,12 +173,12 @@ class ContactModel:
     # ------------------------------------------------------------------ submersion
     def submersion(self, x: np.ndarray) -> tuple[float, float]:
         """(h2, the volume the estimated surface puts under water on the slope), m, m^3."""
-        waterline, eta = x.item(_S), x.item(_ETA)       # floats: the same values
-        heading_cos = math.cos(x.item(_YAW) - self.settings.seaward_yaw_rad)
-        key = (waterline, eta, heading_cos, self.slope_rad)
+        waterline, eta, yaw = x.item(_S), x.item(_ETA), x.item(_YAW)   # floats: the same
+        key = (waterline, eta, yaw, self.slope_rad)       # (the heading's cos on a miss only)
         last = self._submersion
         if last is not None and last[0] == key:
             return last[1]
+        heading_cos = math.cos(yaw - self.settings.seaward_yaw_rad)
         line = self._bottom_line(waterline, eta, heading_cos)
         h2 = buoyancy.submerged_length_of_line_m(*line, self.hull_bow_x_m, self.hull_stern_x_m)
         value = (h2, self.grounded_volume_m3(waterline, eta, heading_cos, line))
