@@ -231,7 +231,15 @@ feeding 106 ms: the loop with idle cores 4.8, mode manager 2.2, drive controller
 (its step ~12 us x 900), EKF 72.1 of which the estimator ~57-60 (the 'bound' line) and
 its conversions, rows, ticks and comparisons ~12. What limits it: the estimator alone is
 about half of the time; with it as it is, everything else would have to fall under ~45 ms
-for 50 k."""
+for 50 k.
+Then (main, 2026-11-28 00:00-00:55) the estimator's remaining hot spots and one copy in the
+replay: the force smoother on scalars, the stance window and the hull line's integrals as
+numba kernels, the covariance propagation over F's listed nonzeros, each IMU sample's
+accelerations once, no repeated contact decision after a heave-only update, the core's
+output dict kept as its row, the submersion's key without a cosine (docs/performance_log.md).
+Idle (00:52): 53.2-55.1 k msg/s through all cores, the target met; land_to_sea's ~100 ms:
+reading 8.6, decoding 2.9, loop 3.1, mode manager 2.4, drive controller 15.6, EKF 56.2 of
+which the estimator ~44 ms."""
 
 ESTIMATOR_PROFILE_HEADER = """cProfile of the estimator alone (EkfRunner, odometry and
 traction read per estimate, as the replay does) on tests/golden/land_to_sea's inputs,
@@ -243,7 +251,10 @@ call each, ~1-1.5 us) and the traction query and submersion work on floats: the 
 alone on land_to_sea ~91 -> ~50 ms CPU.
 (branch i16i, 2026-11-27) The stance detector keeps the sigmas of the IMU's variances
 while they stay (3.8 instead of 4.9 us a sample); its inputs here are converted with the
-same ros_convert rules the replay now calls with fields."""
+same ros_convert rules the replay now calls with fields.
+(main, 2026-11-28) The force smoother on scalars, the stance window and the hull line's
+integrals compiled, the propagation over F's nonzeros, the IMU's accelerations once, no
+repeated contact decision after a heave-only update: ~62 -> ~47 ms on land_to_sea."""
 
 
 def main() -> None:
