@@ -111,12 +111,13 @@ class StanceDetector:
             self._since_t = s.t_s
         self._last_t = s.t_s
         raw = (accel_mps2[0], accel_mps2[1], s.roll_rate_rps, s.pitch_rate_rps)
-        window = (self._times, self._z, self._raw, self._sums, self._ring)
-        result = _push(*window, s.t_s, values, self._sigmas(s), raw, st.window_s)
-        while result[0] < 0:              # the ring is full: twice the room, oldest first
-            self._grow()
+        sigmas = self._sigmas(s)
+        while True:
             result = _push(self._times, self._z, self._raw, self._sums, self._ring, s.t_s,
-                           values, self._sigmas(s), raw, st.window_s)
+                           values, sigmas, raw, st.window_s)
+            if result[0] >= 0:
+                break
+            self._grow()
         n = result[0]
         if n < 2 or s.t_s - self._since_t < st.window_s:
             self.statistic = self.mean_accel_mps2 = self.mean_rate_rps = math.nan
@@ -125,6 +126,7 @@ class StanceDetector:
         return self._decide(*result)
 
     def _grow(self) -> None:
+        """The ring is full (a faster IMU): twice the room, its samples oldest first."""
         head, count = int(self._ring[0]), int(self._ring[1])
         order = (np.arange(count) + head) % self._times.shape[0]
         for name in ('_times', '_z', '_raw'):
