@@ -21,7 +21,6 @@ from dukw_estimation.force_filter import ForceSmoother
 from dukw_common.readings import DriveStatus, ImuSample
 from dukw_estimation.settings import EkfSettings
 
-SLOPE_FRACTION = 0.9             # above this share the pitch is the beach's, not the waves'
 TOUCHDOWN_SHARE = 0.8           # afloat until the mean-surface volume drops below this share
 #: hull volumes remembered by their inputs (one sample asks for the same volume several
 #: times: the contact decision, the traction output, the force update's prediction)
@@ -124,8 +123,14 @@ class ContactModel:
             or heave_accel_mps2 < -self.drop_accel_mps2
 
     def update_slope(self, s: ImuSample, yaw_rad: float, dt: float) -> None:
-        """Low-pass the beach slope along the seaward direction from pitch and roll."""
-        if self.fraction <= SLOPE_FRACTION:
+        """Low-pass the beach slope along the seaward direction from pitch and roll, while
+        the hull lies on the sand: the contact decision says so, the IMU's motion test is
+        under a floating hull's level (1: no floating roll, pitch or heave) and the tracks
+        carry at least ``slope.min_fraction`` of the weight. A hull resting on its tracks
+        has the beach's pitch whatever the water carries of it; a floating one has the
+        waves'."""
+        if self.afloat or self.motion_level > 1.0 \
+                or self.fraction < self.settings.slope_min_fraction:
             return
         rel = yaw_rad - self.settings.seaward_yaw_rad
         measured = s.pitch_rad * math.cos(rel) + s.roll_rad * math.sin(rel)

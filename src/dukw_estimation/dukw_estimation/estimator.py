@@ -186,9 +186,27 @@ class Estimator:
         if self.heave.update(self.ekf, heave, self.motion_filter.position_set) \
                 is Outcome.ACCEPTED and self._contact_states() != before:
             self._refresh_contact()
-        self.contact.update_slope(s, self.ekf.x[Idx.YAW], dt)
+        self._learn_slope(s, dt)
         self._zero_velocity(s)
         return self._count('imu', out)
+
+    def _learn_slope(self, s: ImuSample, dt: float) -> None:
+        """The beach slope from the IMU (``ContactModel.update_slope``). With water at the
+        estimated hulls the waterline distance s is what the water's measurements (the
+        sounder afloat, the wet/dry sensors, the keel at a touchdown, the track forces) made
+        it, and they all see the bed's depth at base_link, s sin(slope): a new slope keeps
+        that depth (s and its covariance scaled by sin(old) / sin(new)). With the hulls dry
+        s is the GPS's and stays."""
+        contact, ekf = self.contact, self.ekf
+        before = contact.slope_rad
+        contact.update_slope(s, ekf.x[Idx.YAW], dt)
+        after = contact.slope_rad
+        if after == before or math.sin(after) <= 0.0 or contact.submersion(ekf.x)[1] <= 0.0:
+            return
+        k = math.sin(before) / math.sin(after)
+        ekf.x[_S] *= k
+        ekf.P[_S, :] *= k
+        ekf.P[:, _S] *= k
 
     def _zero_velocity(self, s: ImuSample) -> None:
         """At rest -- both belts stopped (slower than ``slip.stopped_track_mps``, their

@@ -150,6 +150,10 @@ class EkfSettings:
     # beach slope from pitch/roll
     slope_time_constant_s: float = _f('slope.time_constant_s', 'low-pass of the pitch slope',
                                       0.01, 100)
+    slope_min_fraction: float = _f('slope.min_fraction', 'the slope is learnt while the '
+                                   'contact decision says on the sand and the tracks carry at '
+                                   'least this share of the weight (the hull lies on the '
+                                   "beach: its pitch is the beach's)", 0, 1)
     # drive model (no IMU, or GPS stale)
     drive_time_constant_s: float = _f('drive_model.time_constant_s',
                                       'velocity lag behind the tracks / thrust', 0.01, 100)

@@ -1121,3 +1121,56 @@ def test_at_a_touchdown_the_water_over_the_keel_is_the_draft_it_floated_at():
     the trough's depth off."""
     assert abs(_touchdown_depth_error(make())) < 0.015
     assert abs(_touchdown_depth_error(make(heave_surface_m=1.0, heave_ground_m=1.0))) > 0.04
+
+
+def _lie_on(contact_or_est, pitch_rad, seconds=10.0):
+    """IMU samples of a hull lying still, heading seaward, pitched ``pitch_rad``."""
+    est = contact_or_est if isinstance(contact_or_est, Estimator) else None
+    for k in range(int(round(seconds / 0.01))):
+        s = imu(0.01 * (k + 1), 0.0, 0.0, pitch=pitch_rad)
+        if est is not None:
+            est._learn_slope(s, 0.01)
+        else:
+            contact_or_est.update_slope(s, 0.0, 0.01)
+
+
+def test_the_slope_is_learnt_on_the_sand_in_the_swash_not_afloat_or_rocking():
+    """Issue 18 (i18q): a hull on its tracks has the beach's pitch whatever share the water
+    carries; learnt from ``slope.min_fraction`` on the sand (before: only above 0.9, after the
+    swash), never afloat, below that share or with the motion test at a floating hull's."""
+    configured, drawn = VEHICLE.site.beach_slope_rad, math.radians(3.0)
+    cases = {'swash': (False, 0.5, 0.1), 'afloat': (True, 0.5, 0.1),
+             'light': (False, 0.5 * SETTINGS.slope_min_fraction, 0.1),
+             'rocking': (False, 0.5, 5.0)}
+    learnt = {}
+    for name, (afloat, share, motion) in cases.items():
+        contact = make().contact
+        contact.afloat, contact.fraction, contact.motion_level = afloat, share, motion
+        _lie_on(contact, drawn)
+        learnt[name] = contact.slope_rad
+    assert learnt['swash'] == pytest.approx(drawn, abs=math.radians(0.05))
+    for name in ('afloat', 'light', 'rocking'):
+        assert learnt[name] == configured, name
+
+
+def test_a_new_slope_keeps_the_bed_depth_the_water_placed():
+    """With water at the estimated hulls the waterline distance is what the water's
+    measurements made it (they see s sin(slope)): a new slope keeps that product; with the
+    hulls dry s is the GPS's and stays."""
+    configured, drawn = VEHICLE.site.beach_slope_rad, math.radians(3.0)
+    for s0, wet in ((4.0, True), (-3.0, False)):
+        est = make()
+        est.ekf.x[Idx.S], est.ekf.x[Idx.ETA] = s0, 0.0
+        est.ekf.P[Idx.S, Idx.S] = 0.25
+        est.contact.afloat, est.contact.fraction, est.contact.motion_level = False, 0.6, 0.0
+        assert (est.contact.submersion(est.ekf.x)[1] > 0.0) == wet
+        _lie_on(est, drawn)
+        s = est.ekf.x[Idx.S]
+        assert est.contact.slope_rad == pytest.approx(drawn, abs=math.radians(0.05))
+        if wet:
+            assert s * math.sin(est.contact.slope_rad) == pytest.approx(
+                s0 * math.sin(configured), rel=1e-9)
+            k = s / s0
+            assert est.ekf.P[Idx.S, Idx.S] == pytest.approx(0.25 * k * k, rel=1e-9)
+        else:
+            assert s == s0
