@@ -201,7 +201,7 @@ class Estimator:
         before = contact.slope_rad
         contact.update_slope(s, ekf.x[Idx.YAW], dt)
         after = contact.slope_rad
-        if after == before or math.sin(after) <= 0.0 or contact.submersion(ekf.x)[1] <= 0.0:
+        if after == before or math.sin(after) <= 0.0 or contact.surface_volume_m3(ekf.x) <= 0.0:
             return
         k = math.sin(before) / math.sin(after)
         ekf.x[_S] *= k
