@@ -8,6 +8,9 @@ evidence held for a debounce time, entry and exit thresholds differ
 (hysteresis), and a mode is kept for a minimum dwell time, so waves washing
 over the sensors do not make it chatter. The order is always
 LAND <-> TRANSITION <-> WATER; a needed input going stale gives SAFE_STOP.
+Afloat, both water sensors reading dry (``water_exit_dry_s``) is itself the ground's
+evidence: a floating hull carries them 0.19 m under its waterline (draft 0.49 m, sensors
+0.30 m over the keel), so only hulls the ground holds up out of the water dry both.
 The IMU's attitude is a needed input too: the estimator keeps predicting while
 the IMU is silent, so its own samples are watched.
 
@@ -56,6 +59,8 @@ NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
     ('enter_transition_s', 'debounce land -> transition, s', 0.0, 60.0),
     ('enter_water_s', 'debounce transition -> water, s', 0.0, 60.0),
     ('exit_water_s', 'debounce water -> transition, s', 0.0, 60.0),
+    ('water_exit_dry_s', 'afloat, both water sensors dry this long: the hulls are out of the '
+     'water, on the ground (water -> transition), s', 0.0, 60.0),
     ('enter_land_s', 'debounce transition -> land, s', 0.0, 60.0),
     ('ashore_enter_land_s', 'debounce transition -> land coming ashore (TRANSITION entered '
      'from WATER), s', 0.0, 60.0),
@@ -104,6 +109,7 @@ class ModeSettings:
     enter_transition_s: float         # debounce of each change
     enter_water_s: float
     exit_water_s: float
+    water_exit_dry_s: float           # ... or both sensors dry this long (hulls out of water)
     enter_land_s: float
     ashore_enter_land_s: float        # ... coming ashore (TRANSITION entered from WATER)
     min_dwell_s: float                # a mode is kept at least this long
@@ -206,6 +212,7 @@ class ModeManager:
         self._to_transition = Debounce(settings.enter_transition_s)
         self._to_water = Debounce(settings.enter_water_s)
         self._from_water = Debounce(settings.exit_water_s)
+        self._water_dry = Debounce(settings.water_exit_dry_s)
         self._to_land = Debounce(settings.enter_land_s)
 
     # --- inputs -----------------------------------------------------------------------
@@ -374,7 +381,7 @@ class ModeManager:
             if mode == Mode.WATER:       # the mean weight counts from afloat on
                 self.mean_weight_fraction = self.weight_fraction
             for debounce in (self._to_transition, self._to_water, self._from_water,
-                             self._to_land):
+                             self._water_dry, self._to_land):
                 debounce.reset()
         self._mode = mode
         self._reason = reason
@@ -436,7 +443,12 @@ class ModeManager:
             grounded = self._from_water.update(
                 f > s.water_exit_fraction or self.mean_weight_fraction > s.resting_fraction
                 or self.track_force_n > s.ground_force_n, now_s)
-            if grounded and dwell_done:
+            hulls_dry = self._water_dry.update(not wet_any, now_s)
+            if hulls_dry and dwell_done:
+                self._enter(Mode.TRANSITION, now_s,
+                            f'hulls out of the water: both sensors dry, weight on tracks '
+                            f'{f:.2f}')
+            elif grounded and dwell_done:
                 self._enter(Mode.TRANSITION, now_s,
                             f'tracks on the ground: weight on tracks {f:.2f} (mean '
                             f'{self.mean_weight_fraction:.2f}), track force '
