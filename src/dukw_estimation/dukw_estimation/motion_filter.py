@@ -55,12 +55,9 @@ _H_YAW = np.zeros(N_STATES)
 _H_YAW[_YAW] = 1.0
 _H_YAW.flags.writeable = False
 #: the zero-velocity update's rows (read only): surge u, sway v
-_H_U = np.zeros(N_STATES)
-_H_U[_U] = 1.0
-_H_U.flags.writeable = False
-_H_V = np.zeros(N_STATES)
-_H_V[_V] = 1.0
-_H_V.flags.writeable = False
+_H_REST = np.zeros((2, N_STATES))
+_H_REST[0, _U] = _H_REST[1, _V] = 1.0
+_H_REST.flags.writeable = False
 #: the GPS up velocity's row (read only): the heave rate
 _HEAVE_RATE = int(Idx.HEAVE_RATE)
 _H_HEAVE_RATE = np.zeros(N_STATES)
@@ -352,12 +349,13 @@ class MotionFilter:
 
     # ------------------------------------------------------------------ at rest
     def zero_velocity(self, sigma_mps: float, gate: float) -> Outcome:
-        """The vehicle at rest: surge and sway measured as 0 with ``sigma_mps`` (two scalar
-        updates; the first not accepted is the outcome)."""
+        """The vehicle at rest: surge and sway measured as 0 with ``sigma_mps``, one
+        hypothesis gated as one: (u, v) on their joint Mahalanobis distance (2 degrees of
+        freedom), so a slide the velocity shows rejects the rest whole."""
         var = sigma_mps * sigma_mps
-        out = self.ekf.update_scalar(0.0, float(self.ekf.x[_U]), _H_U, var, gate)
-        out_v = self.ekf.update_scalar(0.0, float(self.ekf.x[_V]), _H_V, var, gate)
-        return out if out is not Outcome.ACCEPTED else out_v
+        x = self.ekf.x
+        return self.ekf.update(np.zeros(2), np.array([x[_U], x[_V]]), _H_REST,
+                               np.diag([var, var]), gate)
 
     # ------------------------------------------------------------------ output
     def odometry(self, slope_rad: float) -> OdometryEstimate:

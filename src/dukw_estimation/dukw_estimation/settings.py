@@ -190,8 +190,9 @@ class EkfSettings:
                                   0, 1)
     zupt_sigma_mps: float = _f('zupt.sigma_mps', 'sigma of the zero surge and sway speed '
                                '(what a still IMU and stopped belts leave unseen)', 1e-4, 1)
-    zupt_gate: float = _f('zupt.mahalanobis', 'rejection distance of the zero speed (a vehicle '
-                          'moving steadily, which the moving variance cannot see)', 0.5, 1e6)
+    zupt_gate: float = _f('zupt.mahalanobis', 'rejection distance of the zero surge and sway '
+                          'speed, jointly (2 degrees of freedom: a vehicle moving steadily, '
+                          'which the moving variance cannot see)', 0.5, 1e6)
     # the measured track forces as a measurement of the weight on the tracks
     force_update_min_slip: float = _f('force_update.min_slip', 'both tracks slipping at least '
                                       'this much: the Wong force then tells the weight', 0, 1)

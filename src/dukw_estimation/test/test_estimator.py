@@ -1060,12 +1060,13 @@ def test_no_zero_velocity_update_when_a_wave_slides_the_sand_under_held_belts():
 def test_no_zero_velocity_update_when_the_tracks_carry_too_little_weight_to_hold():
     """In the surf with a fifth of the weight on the held belts the waves push the hull over
     the sand steadily (campaign run 104: 0.09 m/s for a second at a share of 0.22), the IMU
-    as still as at rest: under zupt.min_fraction no rest; without it the speed is taken
-    to 0 against the GPS's 0.1 m/s."""
+    as still as at rest: under zupt.min_fraction no rest; without it (and with the old gate
+    of 5, which let this slide through: the share's test alone) the speed is taken to 0
+    against the GPS's 0.1 m/s."""
     runs = {}
     for min_fraction in (SETTINGS.zupt_min_fraction, 0.0):
         est = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, force_update_sigma_n=0.0,
-                   zupt_min_fraction=min_fraction)
+                   zupt_min_fraction=min_fraction, zupt_gate=5.0)
         truth = _surf_run(est, 0.0, 0.0, seconds=3.0, x0=6.0, track_mps=0.0, ground_mps=-0.1)
         assert 0.1 < truth < SETTINGS.zupt_min_fraction
         assert est.stance.still and not est.traction().afloat
@@ -1075,6 +1076,45 @@ def test_no_zero_velocity_update_when_the_tracks_carry_too_little_weight_to_hold
     assert held.odometry().surge_mps == pytest.approx(-0.1, abs=0.02)
     assert blind.zero_velocity_updates > 0
     assert abs(blind.odometry().surge_mps) < 0.05
+
+
+def test_no_zero_velocity_update_when_the_velocity_shows_a_slide_under_held_belts():
+    """Issue 18 (seed 2027 run 8): grounded in the swash with half the weight on the held
+    belts, the props push the hull up the sand at 0.07-0.1 m/s; its deceleration is steady,
+    so the IMU is as still as at rest. The rest is one hypothesis, u = v = 0, gated on its
+    joint distance (zupt.mahalanobis, 2 degrees of freedom): the GPS's velocity puts a
+    0.1 m/s slide beyond it and the speed stays; the old gate of 5 took it to 0."""
+    runs = {}
+    for gate in (SETTINGS.zupt_gate, 5.0):
+        est = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, force_update_sigma_n=0.0,
+                   zupt_gate=gate)
+        truth = _surf_run(est, 0.0, 0.0, seconds=3.0, x0=5.0, track_mps=0.0, ground_mps=-0.1)
+        assert truth > SETTINGS.zupt_min_fraction and est.contact.fraction \
+            > SETTINGS.zupt_min_fraction
+        assert est.stance.still and not est.traction().afloat
+        runs[gate] = est
+    gated, loose = runs[SETTINGS.zupt_gate], runs[5.0]
+    assert gated.zero_velocity_updates == 0
+    assert gated.odometry().surge_mps == pytest.approx(-0.1, abs=0.02)
+    assert loose.zero_velocity_updates > 0
+    assert abs(loose.odometry().surge_mps) < 0.05
+
+
+def test_the_zero_velocity_update_takes_or_rejects_surge_and_sway_together():
+    """At rest is one hypothesis: a surge the filter is sure of rejects the sway's zero too
+    (the two were gated one by one: the sway taken to 0 by a rest the surge refuted)."""
+    est = make()
+    P = est.ekf.P
+    P[Idx.U, Idx.U] = P[Idx.V, Idx.V] = 0.02 ** 2
+    P[Idx.U, Idx.V] = P[Idx.V, Idx.U] = 0.0
+    est.ekf.x[Idx.U], est.ekf.x[Idx.V] = 0.1, 0.02      # 4.5 sigma surge, 0.9 sigma sway
+    out = est.motion_filter.zero_velocity(SETTINGS.zupt_sigma_mps, SETTINGS.zupt_gate)
+    assert out is Outcome.REJECTED_OUTLIER
+    assert est.ekf.x[Idx.U] == 0.1 and est.ekf.x[Idx.V] == 0.02
+    est.ekf.x[Idx.U] = 0.03                                  # 1.3 sigma: at rest
+    assert est.motion_filter.zero_velocity(SETTINGS.zupt_sigma_mps, SETTINGS.zupt_gate) \
+        is Outcome.ACCEPTED
+    assert abs(est.ekf.x[Idx.U]) < 0.01 and abs(est.ekf.x[Idx.V]) < 0.01
 
 
 def _touchdown_depth_error(est, x_m=7.6, mean_keel_m=-0.46, hz=0.25):
