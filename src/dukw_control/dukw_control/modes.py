@@ -8,9 +8,12 @@ evidence held for a debounce time, entry and exit thresholds differ
 (hysteresis), and a mode is kept for a minimum dwell time, so waves washing
 over the sensors do not make it chatter. The order is always
 LAND <-> TRANSITION <-> WATER; a needed input going stale gives SAFE_STOP.
-Afloat, both water sensors reading dry (``water_exit_dry_s``) is itself the ground's
-evidence: a floating hull carries them 0.19 m under its waterline (draft 0.49 m, sensors
-0.30 m over the keel), so only hulls the ground holds up out of the water dry both.
+Afloat, both water sensors reading dry with no valid depth under the sounder
+(``water_exit_dry_s``) is itself the ground's evidence: a floating hull carries them 0.19 m
+under its waterline (draft 0.49 m, sensors 0.30 m over the keel), so only hulls the ground
+holds up out of the water dry both; the sounder's water column (valid over about 0.5 m)
+keeps two sensors stuck dry in open water from calling it grounded (the same evidence that
+refuses a forced WATER).
 The IMU's attitude is a needed input too: the estimator keeps predicting while
 the IMU is silent, so its own samples are watched.
 
@@ -59,8 +62,8 @@ NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
     ('enter_transition_s', 'debounce land -> transition, s', 0.0, 60.0),
     ('enter_water_s', 'debounce transition -> water, s', 0.0, 60.0),
     ('exit_water_s', 'debounce water -> transition, s', 0.0, 60.0),
-    ('water_exit_dry_s', 'afloat, both water sensors dry this long: the hulls are out of the '
-     'water, on the ground (water -> transition), s', 0.0, 60.0),
+    ('water_exit_dry_s', 'afloat, both water sensors dry and no valid depth this long: the '
+     'hulls are out of the water, on the ground (water -> transition), s', 0.0, 60.0),
     ('enter_land_s', 'debounce transition -> land, s', 0.0, 60.0),
     ('ashore_enter_land_s', 'debounce transition -> land coming ashore (TRANSITION entered '
      'from WATER), s', 0.0, 60.0),
@@ -443,10 +446,12 @@ class ModeManager:
             grounded = self._from_water.update(
                 f > s.water_exit_fraction or self.mean_weight_fraction > s.resting_fraction
                 or self.track_force_n > s.ground_force_n, now_s)
-            hulls_dry = self._water_dry.update(not wet_any, now_s)
+            hulls_dry = self._water_dry.update(not wet_any and not self._depth_ok(now_s),
+                                               now_s)
             if hulls_dry and dwell_done:
                 self._enter(Mode.TRANSITION, now_s,
-                            f'hulls out of the water: both sensors dry, weight on tracks '
+                            f'hulls out of the water: both sensors dry, no valid depth, '
+                            f'weight on tracks '
                             f'{f:.2f}')
             elif grounded and dwell_done:
                 self._enter(Mode.TRANSITION, now_s,

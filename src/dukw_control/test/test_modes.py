@@ -372,3 +372,15 @@ def test_afloat_dry_sensors_wait_for_the_dwell(mode_settings):
     assert f.mm.mode == Mode.WATER
     f.run(4 * DT, fraction=0.0, force_n=10.0)
     assert f.mm.mode == Mode.TRANSITION
+
+
+def test_afloat_two_sensors_stuck_dry_over_deep_water_keep_water(mode_settings):
+    """Fault: both wet/dry sensors fail dry in open water. The sounder still sees the water
+    column under the hull (valid depth), so the hulls are not out of the water: WATER holds,
+    no TRANSITION <-> WATER chatter; the same dry flags with no valid depth are grounded."""
+    s = mode_settings
+    f = _afloat(s)
+    f.run(10.0, fraction=0.0, depth=True, force_n=10.0)
+    assert [m for m, *_ in f.modes] == [Mode.WATER]
+    f.run(s.water_exit_dry_s + 0.1, fraction=0.0, depth=False, force_n=10.0)
+    assert f.mm.mode == Mode.TRANSITION and 'no valid depth' in f.modes[-1][2]
