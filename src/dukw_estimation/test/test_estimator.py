@@ -1063,19 +1063,30 @@ def test_no_zero_velocity_update_when_the_tracks_carry_too_little_weight_to_hold
     as still as at rest: under zupt.min_fraction no rest; without it (and with the old gate
     of 5, which let this slide through: the share's test alone) the speed is taken to 0
     against the GPS's 0.1 m/s."""
-    runs = {}
     for min_fraction in (SETTINGS.zupt_min_fraction, 0.0):
-        est = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, force_update_sigma_n=0.0,
-                   zupt_min_fraction=min_fraction, zupt_gate=5.0)
-        truth = _surf_run(est, 0.0, 0.0, seconds=3.0, x0=6.0, track_mps=0.0, ground_mps=-0.1)
+        est, truth = _slide_on_held_belts(6.0, zupt_min_fraction=min_fraction, zupt_gate=5.0)
         assert 0.1 < truth < SETTINGS.zupt_min_fraction
-        assert est.stance.still and not est.traction().afloat
-        runs[min_fraction] = est
-    held, blind = runs[SETTINGS.zupt_min_fraction], runs[0.0]
-    assert held.zero_velocity_updates == 0
-    assert held.odometry().surge_mps == pytest.approx(-0.1, abs=0.02)
-    assert blind.zero_velocity_updates > 0
-    assert abs(blind.odometry().surge_mps) < 0.05
+        _assert_rest(est, taken=min_fraction == 0.0)
+
+
+def _slide_on_held_belts(x0_m: float, **settings):
+    """3 s in the surf, the belts held, the hull pushed over the sand at 0.1 m/s, the IMU
+    as still as at rest; the estimator and the truth's weight share."""
+    est = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, force_update_sigma_n=0.0,
+               **settings)
+    truth = _surf_run(est, 0.0, 0.0, seconds=3.0, x0=x0_m, track_mps=0.0, ground_mps=-0.1)
+    assert est.stance.still and not est.traction().afloat
+    return est, truth
+
+
+def _assert_rest(est, taken: bool) -> None:
+    """The slide taken to rest (zero-velocity updates, speed ~0) or not (the GPS's 0.1 m/s)."""
+    if taken:
+        assert est.zero_velocity_updates > 0
+        assert abs(est.odometry().surge_mps) < 0.05
+    else:
+        assert est.zero_velocity_updates == 0
+        assert est.odometry().surge_mps == pytest.approx(-0.1, abs=0.02)
 
 
 def test_no_zero_velocity_update_when_the_velocity_shows_a_slide_under_held_belts():
@@ -1084,20 +1095,11 @@ def test_no_zero_velocity_update_when_the_velocity_shows_a_slide_under_held_belt
     so the IMU is as still as at rest. The rest is one hypothesis, u = v = 0, gated on its
     joint distance (zupt.mahalanobis, 2 degrees of freedom): the GPS's velocity puts a
     0.1 m/s slide beyond it and the speed stays; the old gate of 5 took it to 0."""
-    runs = {}
     for gate in (SETTINGS.zupt_gate, 5.0):
-        est = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, force_update_sigma_n=0.0,
-                   zupt_gate=gate)
-        truth = _surf_run(est, 0.0, 0.0, seconds=3.0, x0=5.0, track_mps=0.0, ground_mps=-0.1)
+        est, truth = _slide_on_held_belts(5.0, zupt_gate=gate)
         assert truth > SETTINGS.zupt_min_fraction and est.contact.fraction \
             > SETTINGS.zupt_min_fraction
-        assert est.stance.still and not est.traction().afloat
-        runs[gate] = est
-    gated, loose = runs[SETTINGS.zupt_gate], runs[5.0]
-    assert gated.zero_velocity_updates == 0
-    assert gated.odometry().surge_mps == pytest.approx(-0.1, abs=0.02)
-    assert loose.zero_velocity_updates > 0
-    assert abs(loose.odometry().surge_mps) < 0.05
+        _assert_rest(est, taken=gate == 5.0)
 
 
 def test_the_zero_velocity_update_takes_or_rejects_surge_and_sway_together():
