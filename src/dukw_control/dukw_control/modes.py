@@ -435,7 +435,7 @@ class ModeManager:
             dry = self._to_land.update(
                 not wet_any and f > s.land_enter_fraction, now_s,
                 s.ashore_enter_land_s if self._previous == Mode.WATER else None)
-            if afloat and dwell_done:
+            if afloat and (dwell_done or self._seaward()):
                 self._enter(Mode.WATER, now_s,
                             f'afloat: weight on tracks {f:.2f}, track force '
                             f'{self.track_force_n:.0f} N at friction')
@@ -458,6 +458,14 @@ class ModeManager:
                             f'tracks on the ground: weight on tracks {f:.2f} (mean '
                             f'{self.mean_weight_fraction:.2f}), track force '
                             f'{self.track_force_n:.0f} N')
+
+    def _seaward(self) -> bool:
+        """Going to sea (LAND -> TRANSITION), WATER may follow without min_dwell_s: the
+        dwell guards against going back with each wave, and WATER here is onward, on its own
+        evidence (enter_water_s held from the estimator's afloat). A vehicle that reached
+        the surf 1.9 s before the water floated it was held in TRANSITION to the dwell's end
+        (issue 18, seed 2027 run 22: WATER 1.06 s after the truth)."""
+        return self._previous == Mode.LAND
 
     def _ashore(self, dwell_s: float) -> bool:
         """Coming ashore (WATER -> TRANSITION), LAND may follow after ashore_dwell_s: the

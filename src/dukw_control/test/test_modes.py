@@ -258,6 +258,35 @@ def test_back_from_land_transition_keeps_the_full_dwell(mode_settings):
     assert [m for m, *_ in f.modes] == [Mode.LAND, Mode.TRANSITION, Mode.LAND]
 
 
+def test_to_sea_water_follows_transition_without_the_dwell(mode_settings):
+    # issue 18 (seed 2027 run 22): LAND -> TRANSITION -> WATER is onward; min_dwell_s holds
+    # a change back, so WATER follows its own evidence after enter_water_s, not the dwell
+    s = mode_settings
+    assert s.enter_transition_s + s.enter_water_s + 1.2 < s.min_dwell_s
+    f = Feed(s)
+    f.run(s.min_dwell_s + 0.5)
+    f.run(s.enter_transition_s + 0.1, fraction=0.8, fore=True, aft=True)
+    assert f.mm.mode == Mode.TRANSITION
+    entered_s = f.modes[-1][1]
+    # the track force's low pass falls to friction, then enter_water_s
+    f.run(s.enter_water_s + 1.0, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    assert [m for m, *_ in f.modes] == [Mode.LAND, Mode.TRANSITION, Mode.WATER]
+    assert f.modes[-1][1] - entered_s < s.min_dwell_s
+
+
+def test_back_to_water_from_an_ashore_transition_keeps_the_full_dwell(mode_settings):
+    # WATER -> TRANSITION -> WATER is going back: min_dwell_s holds
+    s = mode_settings
+    f = Feed(s)
+    f.run(s.min_dwell_s + 0.5, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    f.run(s.exit_water_s + 0.1, fraction=0.6, fore=True, aft=True, force_n=300.0)
+    assert f.mm.mode == Mode.TRANSITION
+    f.run(s.min_dwell_s - 1.0, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    assert f.mm.mode == Mode.TRANSITION
+    f.run(1.5, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    assert [m for m, *_ in f.modes] == [Mode.WATER, Mode.TRANSITION, Mode.WATER]
+
+
 def test_an_ashore_dwell_beyond_min_dwell_is_refused(mode_settings):
     with pytest.raises(ValueError, match='ashore_dwell_s'):
         ModeSettings(**{**dataclasses.asdict(mode_settings),
