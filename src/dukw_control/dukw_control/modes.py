@@ -67,7 +67,8 @@ NODE_PARAMS: tuple[tuple[str, str, float | None, float | None], ...] = (
     ('enter_land_s', 'debounce transition -> land, s', 0.0, 60.0),
     ('ashore_enter_land_s', 'debounce transition -> land coming ashore (TRANSITION entered '
      'from WATER), s', 0.0, 60.0),
-    ('min_dwell_s', 'a mode is kept at least this long, s', 0.0, 600.0),
+    ('min_dwell_s', 'no change back within this of entering a mode (onward changes out of '
+     'TRANSITION need none), s', 0.0, 600.0),
     ('ashore_dwell_s', 'TRANSITION entered from WATER is kept at least this long before '
      'LAND (onward, not back; props stay on in LAND after a wet read), s', 0.0, 600.0),
     ('transition_track_weight', 'share of the request to the tracks in the transition',
@@ -115,7 +116,7 @@ class ModeSettings:
     water_exit_dry_s: float           # ... or both sensors dry this long (hulls out of water)
     enter_land_s: float
     ashore_enter_land_s: float        # ... coming ashore (TRANSITION entered from WATER)
-    min_dwell_s: float                # a mode is kept at least this long
+    min_dwell_s: float                # no change back within this (onward: see _seaward)
     ashore_dwell_s: float             # ... but WATER -> TRANSITION -> LAND after this
     transition_track_weight: float
     transition_prop_weight: float
@@ -451,8 +452,7 @@ class ModeManager:
             if hulls_dry and dwell_done:
                 self._enter(Mode.TRANSITION, now_s,
                             f'hulls out of the water: both sensors dry, no valid depth, '
-                            f'weight on tracks '
-                            f'{f:.2f}')
+                            f'weight on tracks {f:.2f}')
             elif grounded and dwell_done:
                 self._enter(Mode.TRANSITION, now_s,
                             f'tracks on the ground: weight on tracks {f:.2f} (mean '
