@@ -414,7 +414,11 @@ class SimCore:
         dt = self.dt_s
         u0, v0, hv0 = self.u, self.v, self.heave_vel
         c, s = math.cos(self.yaw), math.sin(self.yaw)
+        grounded = self.in_contact
         imm, w_eff, hydro = self._contact_and_immersion()
+        # the pose at the step's start (on the sand: the beach's there) and whether it lay
+        # on the sand: the rates of a touchdown within the step follow from it (_touchdown)
+        self._step_pose = (self.z_cg, self.pitch, self.roll, grounded)
         _, water, depths, areas, sums = hydro
         body = self.vehicle.body
         waves = wave_forcing(self.world.calm, areas, self.hull.strip_length_m, water,
@@ -748,6 +752,22 @@ class SimCore:
         self.pitch_rate = (npitch - self.pitch) / dt
         self.z_cg, self.pitch, self.roll = nz, npitch, nroll
 
+    def _touchdown_rates(self) -> None:
+        """The rates on touching down. A hull that fell onto the sand stops (an inelastic
+        impact: the IMU's jolt). One that lay on the beach at the step's start, lifted off in
+        it and met the beach again never left it: it keeps the rates of its pose's change
+        over the step, the beach's under it, as on the ground (``_follow_ground``); stopping
+        it read as a 3-7 m/s^2 landing jolt in the IMU each time a wave nearly floated a
+        vehicle climbing the beach (issue 18, campaign seed 2026 runs 0 and 173)."""
+        z0, pitch0, roll0, grounded = self._step_pose
+        if not grounded:
+            self.heave_vel = self.roll_rate = self.pitch_rate = 0.0
+            return
+        dt = self.dt_s
+        self.heave_vel = (self.z_cg - z0) / dt
+        self.pitch_rate = (self.pitch - pitch0) / dt
+        self.roll_rate = (self.roll - roll0) / dt
+
     def _float_free(self, imm: Immersion, waves: WaveMoments, sums: StripSums) -> None:
         """Afloat: heave, roll and pitch under the strips' buoyancy (and the waves' strip
         moments), with damping scaled by the submerged share, then touch down if a track end
@@ -897,11 +917,14 @@ class SimCore:
         if self._grounded_buoyancy() >= self._weight:
             self.z_cg, self.pitch, self.roll = floating
             self.z_cg += gz - lowest
-            self.heave_vel = max(self.heave_vel, 0.0)
+            # the sand lifts the track end clear: the hull rises at the rate it moved over the
+            # step (at least its own), as a hull on the beach follows it (the heave once
+            # stopped while the sand lifted it: the IMU felt no climb, a jolt at each end)
+            self.heave_vel = max(self.heave_vel, (self.z_cg - self._step_pose[0]) / self.dt_s)
             self.grazing = True
             return
         self.in_contact = True
-        self.heave_vel = self.roll_rate = self.pitch_rate = 0.0
+        self._touchdown_rates()
 
     # ---------------------------------------------------------------------- truth
     def _at_rest(self, volume: float) -> _Stepped:

@@ -489,3 +489,28 @@ def test_the_zero_speed_yaw_damping_is_the_strips_cross_flow_drag():
     assert wat.yaw_linear_drag_nm_per_rps == pytest.approx(
         wat.sway_linear_drag_n_per_mps * float(np.mean(np.square(sim.hull.station_x_m))),
         rel=0.01)
+
+
+def test_on_the_sand_the_heave_rate_is_the_rate_of_the_height():
+    """Climbing out of a 17 cm sea: on the sand (at both ends of a step, also one in which
+    the water lifted the hull off the beach and the beach met it again) and grazing it, the
+    truth's heave rate, whose change the IMU feels, is the rate of base_link's height.
+    Before, the sand lifting a grazing track end and a lift-off met by the beach stopped
+    the heave: 2-7 m/s^2 jolts in the IMU with no landing (issue 18: here 1 and 85 steps)."""
+    sim = SimCore.from_config(overrides={'waves.model': 'irregular',
+                                         'waves.significant_height_m': 0.17}, seed=0)
+    body = sim.vehicle.body
+    before = sim.reset(x_m=(body.draft_m + 0.3) / math.tan(sim.vehicle.site.beach_slope_rad),
+                       yaw_rad=math.pi)
+    steps = {'on the sand': 0, 'grazing': 0}
+    for _ in range(2500):
+        was = (sim.in_contact, sim.grazing)
+        truth = sim.step(Actuation(40, 40))
+        kind = 'on the sand' if was[0] and sim.in_contact else \
+            'grazing' if was[1] and sim.grazing else None
+        if kind is not None:
+            steps[kind] += 1
+            assert truth.heave_mps == pytest.approx((truth.z_m - before.z_m) / sim.dt_s,
+                                                    abs=0.01), (kind, truth.t_s)
+        before = truth
+    assert steps['on the sand'] > 500 and steps['grazing'] > 50
