@@ -183,7 +183,8 @@ class Estimator:
         self.contact.observe_imu(s, heave, dt)
         self._refresh_contact()
         before = self._contact_states()
-        if self.heave.update(self.ekf, heave, self.motion_filter.position_set) \
+        drop = self.contact.track_end_drop_m(s, self.ekf.x.item(_YAW))
+        if self.heave.update(self.ekf, heave, self.motion_filter.position_set, drop) \
                 is Outcome.ACCEPTED and self._contact_states() != before:
             self._refresh_contact()
         self._learn_slope(s, dt)

@@ -68,6 +68,7 @@ class HeaveObserver:
         self.last_accel_mps2 = math.nan  # the last heave acceleration short of an impact
         self.impact_drafts = 0           # drafts measured when the sand struck the keel
         self.held_at_beach = 0           # afloat, drafts asking for more water at the beach
+        self.track_end_drop_m = 0.0      # the lowest track point below the keel's middle, m
 
     def keel_depth_m(self, volume_m3: float) -> tuple[float, float]:
         """(The keel's depth under a level surface with ``volume_m3`` of the hulls under it,
@@ -80,7 +81,8 @@ class HeaveObserver:
         per_m3 = (d1 - d0) / (v1 - v0)
         return float(d0 + (volume_m3 - v0) * per_m3), float(per_m3)
 
-    def update(self, ekf: MotionEkf, heave_accel_mps2: float, placed: bool) -> Outcome:
+    def update(self, ekf: MotionEkf, heave_accel_mps2: float, placed: bool,
+               track_end_drop_m: float = 0.0) -> Outcome:
         """The measurement the contact decision implies, for one IMU sample: afloat the keel
         under the wave by the dynamic draft, on the sand the keel on the beach. Nothing before
         the filter is ``placed`` (its first fix: the waterline distance, the contact decision
@@ -90,7 +92,10 @@ class HeaveObserver:
         itself, whatever the contact decision says (it may have said the sand while the hull
         still floated): the hull floated up to the sample before, so the water over the keel
         is the dynamic draft of that sample's acceleration, measured then, with the keel at
-        the beach (the keel-at-beach bound does not apply)."""
+        the beach (the keel-at-beach bound does not apply). ``track_end_drop_m``: the lowest
+        track point this far below the keel's middle (``ContactModel.track_end_drop_m``):
+        it, not the middle, meets the beach."""
+        self.track_end_drop_m = track_end_drop_m
         if not placed:
             return Outcome.IGNORED
         impact = self.contact.impact(heave_accel_mps2)
@@ -107,13 +112,14 @@ class HeaveObserver:
         return self._on_sand(ekf, touchdown)
 
     def _beach_row(self, x: np.ndarray) -> tuple[float, np.ndarray]:
-        """The keel's height over the estimated beach under it, heave + s sin(slope), m,
-        and its Jacobian."""
+        """The lowest track point's height over the estimated beach under base_link,
+        heave - track_end_drop_m + s sin(slope), m, and its Jacobian (a hull tilted against
+        the beach rests on a track end, its keel's middle above the beach)."""
         sin_t = math.sin(self.contact.slope_rad)
         h = np.zeros(N_STATES)
         h[_HEAVE] = 1.0
         h[_S] = sin_t
-        return float(x[_HEAVE] + x[_S] * sin_t), h
+        return float(x[_HEAVE] - self.track_end_drop_m + x[_S] * sin_t), h
 
     def _on_sand(self, ekf: MotionEkf, touchdown: bool) -> Outcome:
         """The keel on the beach. At a touchdown the floating hull's keel meets the beach:

@@ -1216,3 +1216,30 @@ def test_a_new_slope_keeps_the_bed_depth_the_water_placed():
             assert est.ekf.P[Idx.S, Idx.S] == pytest.approx(0.25 * k * k, rel=1e-9)
         else:
             assert s == s0
+
+
+def test_a_hull_tilted_on_the_beach_touches_down_on_a_track_end():
+    """A hull pitched against the beach (afloat in the waves, or grazing the sand) meets it
+    with a track end, its keel's middle half a track length x sin(tilt) above the beach:
+    the touchdown's tie of heave, wave and waterline puts that point, not the middle, on
+    the beach (issue 18: ties of the middle read a grazing hull 5-8 cm lower, the water
+    shallower, the weight on the tracks 0.24 as 0.9). A hull lying still lies on its
+    tracks: no drop (its pitch is the beach's, whatever the estimated slope says)."""
+    body = VEHICLE.body
+    contact = make().contact
+    tilt = math.radians(5.0)
+    tilted = imu(0.0, 0.0, 0.0, pitch=contact.slope_rad + tilt)
+    assert contact.track_end_drop_m(tilted, 0.0) == 0.0        # lying still: on its tracks
+    contact.motion_level = 2.0                                 # pitching, heaving
+    drop = contact.track_end_drop_m(tilted, 0.0)
+    assert drop == pytest.approx(0.5 * body.track_contact_length_m * math.sin(tilt))
+    assert contact.track_end_drop_m(imu(0.0, 0.0, 0.0, pitch=contact.slope_rad), 0.0) \
+        == pytest.approx(0.0, abs=1e-12)                       # the beach's pitch: none
+    for given, moved in ((drop, False), (0.0, True)):
+        est = make()
+        x = _afloat_at(est, drop, body.draft_m)          # the middle `drop` over the beach
+        est.contact.afloat, est.heave.was_afloat = False, True     # touching down now
+        before = (float(x[Idx.S]), float(x[Idx.HEAVE]), float(x[Idx.ETA]))
+        assert est.heave.update(est.ekf, 0.0, True, given) is Outcome.ACCEPTED
+        change = max(abs(a - b) for a, b in zip(before, (x[Idx.S], x[Idx.HEAVE], x[Idx.ETA])))
+        assert (change > 1e-3) == moved, (given, change)
