@@ -414,10 +414,10 @@ class SimCore:
         dt = self.dt_s
         u0, v0, hv0 = self.u, self.v, self.heave_vel
         c, s = math.cos(self.yaw), math.sin(self.yaw)
-        grounded = self.in_contact
+        grounded = self.in_contact or self.grazing
         imm, w_eff, hydro = self._contact_and_immersion()
-        # the pose at the step's start (on the sand: the beach's there) and whether it lay
-        # on the sand: the rates of a touchdown within the step follow from it (_touchdown)
+        # the pose at the step's start and whether the hull touched the sand then (lying on
+        # it or grazing it): a touchdown's rates within the step follow (_touchdown_rates)
         self._step_pose = (self.z_cg, self.pitch, self.roll, grounded)
         _, water, depths, areas, sums = hydro
         body = self.vehicle.body
@@ -753,12 +753,13 @@ class SimCore:
         self.z_cg, self.pitch, self.roll = nz, npitch, nroll
 
     def _touchdown_rates(self) -> None:
-        """The rates on touching down. A hull that fell onto the sand stops (an inelastic
-        impact: the IMU's jolt). One that lay on the beach at the step's start, lifted off in
-        it and met the beach again never left it: it keeps the rates of its pose's change
-        over the step, the beach's under it, as on the ground (``_follow_ground``); stopping
-        it read as a 3-7 m/s^2 landing jolt in the IMU each time a wave nearly floated a
-        vehicle climbing the beach (issue 18, campaign seed 2026 runs 0 and 173)."""
+        """The rates on touching down. A hull that fell onto the sand from afloat stops (an
+        inelastic impact: the IMU's jolt). One that touched the beach at the step's start,
+        lying on it or grazing it with a track end, never left it: it keeps the rates of its
+        pose's change over the step, as on the ground (``_follow_ground``): a lift-off the
+        beach met again, a grazing hull settling onto its tracks. Stopping it read as a 3-7
+        m/s^2 jolt in the IMU with no landing, which the estimator took for a dynamic draft
+        (issue 18: seed 2026 runs 0, 173, seed 2027 run 86, the wave 8-11 cm low)."""
         z0, pitch0, roll0, grounded = self._step_pose
         if not grounded:
             self.heave_vel = self.roll_rate = self.pitch_rate = 0.0
