@@ -1241,5 +1241,6 @@ def test_a_hull_tilted_on_the_beach_touches_down_on_a_track_end():
         est.contact.afloat, est.heave.was_afloat = False, True     # touching down now
         before = (float(x[Idx.S]), float(x[Idx.HEAVE]), float(x[Idx.ETA]))
         assert est.heave.update(est.ekf, 0.0, True, given) is Outcome.ACCEPTED
-        change = max(abs(a - b) for a, b in zip(before, (x[Idx.S], x[Idx.HEAVE], x[Idx.ETA])))
+        after = (x[Idx.S], x[Idx.HEAVE], x[Idx.ETA])
+        change = max(abs(a - b) for a, b in zip(before, after, strict=True))
         assert (change > 1e-3) == moved, (given, change)

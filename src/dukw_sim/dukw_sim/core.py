@@ -304,6 +304,7 @@ class SimCore:
             self.in_contact = False
             self.z_cg = self._float_height()
             self.pitch = self.roll = 0.0
+        self._step_pose = (self.z_cg, self.pitch, self.roll, self.in_contact)   # (step's)
         self.truth = self._compute_truth(Actuation(), None)
         return self.truth
 
