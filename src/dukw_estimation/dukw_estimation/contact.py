@@ -139,9 +139,8 @@ class ContactModel:
 
     def track_end_drop_m(self, s: ImuSample, yaw_rad: float) -> float:
         """How far the lowest point of the tracks hangs below base_link (the keel's middle),
-        m: the hull's pitch and roll (the IMU's) against the estimated beach's under it
-        tilt a track end down, half a track length and half the hulls' separation out
-        (0 lying flat on the beach). A hull meets the beach with that point first: afloat
+        m (``traction.track_end_drop_m``) for the hull's pitch and roll (the IMU's) against
+        the estimated beach's under it. A hull meets the beach with that point first: afloat
         it pitches with the waves, and grazing the sand it rests on it. A hull lying still
         (the IMU's motion test under a floating hull's level, 1) lies on its tracks: none
         (its pitch is the beach's, which the estimated slope may not yet be)."""
@@ -149,10 +148,9 @@ class ContactModel:
             return 0.0
         rel = yaw_rad - self.settings.seaward_yaw_rad
         body = self.vehicle.body
-        pitch = s.pitch_rad - self.slope_rad * math.cos(rel)
-        roll = s.roll_rad - self.slope_rad * math.sin(rel)
-        return 0.5 * body.track_contact_length_m * abs(math.sin(pitch)) \
-            + 0.5 * body.hull_separation_m * abs(math.sin(roll))
+        return traction.track_end_drop_m(body.track_contact_length_m, body.hull_separation_m,
+                                         s.pitch_rad - self.slope_rad * math.cos(rel),
+                                         s.roll_rad - self.slope_rad * math.sin(rel))
 
     # ------------------------------------------------------------------ tracks
     def smooth_track_forces(self, s: DriveStatus) -> None:

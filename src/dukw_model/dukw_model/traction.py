@@ -162,6 +162,17 @@ def track_force_n(track_speed_mps: ArrayLike, ground_speed_mps: ArrayLike,
     return float(out) if out.ndim == 0 else out
 
 
+def track_end_drop_m(track_length_m: float, track_separation_m: float,
+                     pitch_rel_rad: float, roll_rel_rad: float) -> float:
+    """How far the lowest point of the two tracks hangs below base_link (their middle), m,
+    for a hull pitched and rolled this much against the ground under it: half a track length
+    and half the tracks' separation out (0 lying flat on it). A tilted hull meets the
+    ground with that point first (the simulator's touchdown, the estimator's keel-on-beach
+    measurement)."""
+    return 0.5 * track_length_m * abs(math.sin(pitch_rel_rad)) \
+        + 0.5 * track_separation_m * abs(math.sin(roll_rel_rad))
+
+
 def effective_weight_n(displacement_n: float, submerged_volume_m3: ArrayLike,
                        slope_rad: ArrayLike, water_density_kgpm3: float,
                        gravity_mps2: float) -> ArrayLike:

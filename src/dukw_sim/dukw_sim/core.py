@@ -910,8 +910,9 @@ class SimCore:
                               beach.height_m(self.x + half)) + _CLEAR_MARGIN_M:
             return
         gz, gpitch, groll, _ = self._ground_pose()
-        lowest = base - half * abs(math.sin(self.pitch - gpitch)) \
-            - self._half_sep * abs(math.sin(self.roll - groll))
+        lowest = base - traction.track_end_drop_m(
+            self._track_len, self.vehicle.body.hull_separation_m, self.pitch - gpitch,
+            self.roll - groll)
         if lowest > gz:
             return
         floating = (self.z_cg, self.pitch, self.roll)
