@@ -274,6 +274,57 @@ def test_to_sea_water_follows_transition_without_the_dwell(mode_settings):
     assert f.modes[-1][1] - entered_s < s.min_dwell_s
 
 
+def _to_sea_transition(s):
+    """A manager that went LAND -> TRANSITION (to sea) and has waited out its dwell."""
+    f = Feed(s)
+    f.run(s.min_dwell_s + 0.5)
+    f.run(s.min_dwell_s + 0.5, fraction=0.6, fore=True, aft=True)
+    assert [m for m, *_ in f.modes] == [Mode.LAND, Mode.TRANSITION]
+    return f
+
+
+def test_to_sea_a_light_touchdown_after_the_first_float_keeps_the_water_count(mode_settings):
+    # issue 18 (seed 2027 run 108): afloat for 0.3 s, then a trough sets the hull on the sand
+    # with the share read over water_enter_fraction (yet under water_exit_fraction, where
+    # WATER itself would call it grounded): WATER follows enter_water_s from the first float
+    s = mode_settings
+    f = _to_sea_transition(s)
+    f.run(0.5, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)   # force low-passed
+    floated_s = f.t
+    f.run(0.3, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    assert f.mm.mode == Mode.TRANSITION
+    touchdown = 0.5 * (s.water_enter_fraction + s.water_exit_fraction)
+    f.run(s.enter_water_s, fraction=touchdown, fore=True, aft=True, force_n=10.0,
+          afloat=False)
+    assert f.mm.mode == Mode.WATER
+    assert f.modes[-1][1] - floated_s <= s.enter_water_s + 0.3 + 2 * DT
+
+
+def test_to_sea_a_grounding_past_water_exit_fraction_restarts_the_water_count(mode_settings):
+    s = mode_settings
+    f = _to_sea_transition(s)
+    f.run(0.8, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    f.run(s.enter_water_s, fraction=s.water_exit_fraction + 0.05, fore=True, aft=True,
+          force_n=10.0, afloat=False)
+    assert f.mm.mode == Mode.TRANSITION
+
+
+def test_coming_ashore_a_light_touchdown_restarts_the_count_back_to_water(mode_settings):
+    # WATER -> TRANSITION -> WATER is going back: the count holds only under
+    # water_enter_fraction, as it starts
+    s = mode_settings
+    f = Feed(s)
+    f.run(s.min_dwell_s + 0.5, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    f.run(s.exit_water_s + 0.1, fraction=0.6, fore=True, aft=True, force_n=300.0)
+    f.run(s.min_dwell_s, fraction=0.6, fore=True, aft=True, force_n=10.0)
+    assert [m for m, *_ in f.modes] == [Mode.WATER, Mode.TRANSITION]
+    f.run(0.3, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    touchdown = 0.5 * (s.water_enter_fraction + s.water_exit_fraction)
+    f.run(s.enter_water_s, fraction=touchdown, fore=True, aft=True, force_n=10.0,
+          afloat=False)
+    assert f.mm.mode == Mode.TRANSITION
+
+
 def test_back_to_water_from_an_ashore_transition_keeps_the_full_dwell(mode_settings):
     # WATER -> TRANSITION -> WATER is going back: min_dwell_s holds
     s = mode_settings
