@@ -283,6 +283,18 @@ def _to_sea_transition(s):
     return f
 
 
+def _float_then_touch_down(f, s, float_s):
+    """Afloat for ``float_s`` (track force at friction), then a trough sets the hull on the
+    sand for enter_water_s, read between water_enter_fraction and water_exit_fraction, the
+    estimator's contact decision on the sand; returns the mode at the float's end."""
+    f.run(float_s, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    afloat_mode = f.mm.mode
+    touchdown = 0.5 * (s.water_enter_fraction + s.water_exit_fraction)
+    f.run(s.enter_water_s, fraction=touchdown, fore=True, aft=True, force_n=10.0,
+          afloat=False)
+    return afloat_mode
+
+
 def test_to_sea_a_light_touchdown_after_the_first_float_keeps_the_water_count(mode_settings):
     # issue 18 (seed 2027 run 108): afloat for 0.3 s, then a trough sets the hull on the sand
     # with the share read over water_enter_fraction (yet under water_exit_fraction, where
@@ -291,11 +303,7 @@ def test_to_sea_a_light_touchdown_after_the_first_float_keeps_the_water_count(mo
     f = _to_sea_transition(s)
     f.run(0.5, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)   # force low-passed
     floated_s = f.t
-    f.run(0.3, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
-    assert f.mm.mode == Mode.TRANSITION
-    touchdown = 0.5 * (s.water_enter_fraction + s.water_exit_fraction)
-    f.run(s.enter_water_s, fraction=touchdown, fore=True, aft=True, force_n=10.0,
-          afloat=False)
+    assert _float_then_touch_down(f, s, 0.3) == Mode.TRANSITION
     assert f.mm.mode == Mode.WATER
     assert f.modes[-1][1] - floated_s <= s.enter_water_s + 0.3 + 2 * DT
 
@@ -309,29 +317,30 @@ def test_to_sea_a_grounding_past_water_exit_fraction_restarts_the_water_count(mo
     assert f.mm.mode == Mode.TRANSITION
 
 
+def _ashore_transition(s):
+    """A manager that went WATER -> TRANSITION (coming ashore: the tracks on the ground)."""
+    f = Feed(s)
+    f.run(s.min_dwell_s + 0.5, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
+    f.run(s.exit_water_s + 0.1, fraction=0.6, fore=True, aft=True, force_n=300.0)
+    assert f.mm.mode == Mode.TRANSITION
+    return f
+
+
 def test_coming_ashore_a_light_touchdown_restarts_the_count_back_to_water(mode_settings):
     # WATER -> TRANSITION -> WATER is going back: the count holds only under
     # water_enter_fraction, as it starts
     s = mode_settings
-    f = Feed(s)
-    f.run(s.min_dwell_s + 0.5, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
-    f.run(s.exit_water_s + 0.1, fraction=0.6, fore=True, aft=True, force_n=300.0)
+    f = _ashore_transition(s)
     f.run(s.min_dwell_s, fraction=0.6, fore=True, aft=True, force_n=10.0)
     assert [m for m, *_ in f.modes] == [Mode.WATER, Mode.TRANSITION]
-    f.run(0.3, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
-    touchdown = 0.5 * (s.water_enter_fraction + s.water_exit_fraction)
-    f.run(s.enter_water_s, fraction=touchdown, fore=True, aft=True, force_n=10.0,
-          afloat=False)
+    assert _float_then_touch_down(f, s, 0.3) == Mode.TRANSITION
     assert f.mm.mode == Mode.TRANSITION
 
 
 def test_back_to_water_from_an_ashore_transition_keeps_the_full_dwell(mode_settings):
     # WATER -> TRANSITION -> WATER is going back: min_dwell_s holds
     s = mode_settings
-    f = Feed(s)
-    f.run(s.min_dwell_s + 0.5, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
-    f.run(s.exit_water_s + 0.1, fraction=0.6, fore=True, aft=True, force_n=300.0)
-    assert f.mm.mode == Mode.TRANSITION
+    f = _ashore_transition(s)
     f.run(s.min_dwell_s - 1.0, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
     assert f.mm.mode == Mode.TRANSITION
     f.run(1.5, fraction=0.0, fore=True, aft=True, depth=True, force_n=10.0)
