@@ -349,14 +349,13 @@ class ModeManager:
         estimator's contact decision: at start-up its IMU motion test has no history yet
         (it reads a hull lying still), so a hull started afloat would be called grounded."""
         f = self.weight_fraction
-        if self._afloat_evidence(self.depth_valid, True):
+        if self._afloat_evidence(self.depth_valid, True, self.s.water_enter_fraction):
             return Mode.WATER, f'afloat (weight on tracks {f:.2f})'
         if self.fore_wet or self.aft_wet or f < self.s.transition_enter_fraction:
             return Mode.TRANSITION, f'in the surf (weight on tracks {f:.2f}, {self._wet_text()})'
         return Mode.LAND, f'on land (weight on tracks {f:.2f}, sensors dry)'
 
-    def _afloat_evidence(self, depth_ok: bool, started: bool,
-                         share_limit: float | None = None) -> bool:
+    def _afloat_evidence(self, depth_ok: bool, started: bool, share_limit: float) -> bool:
         """Afloat: little weight on the tracks, their force at drivetrain friction, water
         under the sounder or over both sensors, and (``water_needs_estimated_afloat``) the
         estimator's own contact decision afloat when the count starts (``started``: it
@@ -367,10 +366,9 @@ class ModeManager:
         water has set down on the sand from one it still carries. It starts the count but
         need not hold it: in a long, low sea a floating hull's motion comes and goes about
         the motion test's threshold with each wave. ``share_limit``: the share under which
-        it holds (else water_enter_fraction; see ``_water_count_share``)."""
+        it holds (water_enter_fraction, or while counting ``_water_count_share``)."""
         s = self.s
-        limit = s.water_enter_fraction if share_limit is None else share_limit
-        return (self.weight_fraction < limit
+        return (self.weight_fraction < share_limit
                 and self.track_force_n <= s.friction_force_n
                 and (depth_ok or (self.fore_wet and self.aft_wet))
                 and (self.estimated_afloat or started or not s.water_needs_estimated_afloat))
