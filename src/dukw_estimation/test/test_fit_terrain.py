@@ -6,13 +6,16 @@ import numpy as np
 import pytest
 from rosbags.rosbag2 import Writer
 
-from dukw_common.vehicle import SoilParams, Vehicle
+from dukw_common.config import shared_params
+from dukw_common.vehicle import SoilParams, Vehicle, soil_params
 from dukw_estimation import fit_terrain
 from dukw_model import traction
 
 VEHICLE = Vehicle.load()
 BODY = VEHICLE.body
 AREA = BODY.track_width_m * BODY.track_contact_length_m
+#: the paper's beach fits' upper end (phi 15 deg, k 0.18 m: its 80 % slope fit, config/dukw.yaml)
+PAPER_BEACH_MAX = soil_params(shared_params(), 'beach_80')
 TRUE = SoilParams(cohesion_pa=150.0, friction_angle_rad=math.radians(9.93), shear_modulus_m=0.053)
 
 
@@ -99,8 +102,9 @@ def test_recovers_the_simulated_beach_from_a_recorded_surf_run(capsys):
     fit = fit_terrain.fit_soil(fit_terrain.read_samples(bag), AREA,
                                BODY.track_contact_length_m, initial=VEHICLE.soil)
     truth = VEHICLE.soil                  # the simulator's wet beach
-    assert truth.friction_angle_rad < fit.soil.friction_angle_rad < math.radians(15.0)
-    assert truth.shear_modulus_m < fit.soil.shear_modulus_m < 0.18
+    assert truth.friction_angle_rad < fit.soil.friction_angle_rad \
+        < PAPER_BEACH_MAX.friction_angle_rad
+    assert truth.shear_modulus_m < fit.soil.shear_modulus_m < PAPER_BEACH_MAX.shear_modulus_m
     assert abs(fit.soil.cohesion_pa - truth.cohesion_pa) < 3 * fit.sigma[0]
     assert fit.residual_rms_n < 50.0
     # all samples, the stopped tracks' clipped slips and the gripping ones included: off
