@@ -58,6 +58,9 @@ class EkfSettings:
     # measurement noise (used when a message carries no covariance)
     gps_position_m: float = _f('noise.gps_position_m', 'DGPS position sigma', 1e-4, 100)
     gps_velocity_mps: float = _f('noise.gps_velocity_mps', 'DGPS velocity sigma', 1e-4, 10)
+    track_speed_sigma_mps: float = _f(
+        'noise.track_speed_mps', "a belt's speed reading sigma (the encoder's noise; 0: the "
+        'readings exact)', 0, 1)
     yaw_rad: float = _f('noise.yaw_rad', 'IMU/compass heading sigma', 1e-5, 1)
     gyro_rps: float = _f('noise.gyro_rps', 'gyro z sigma', 1e-6, 1)
     contact_m: float = _f('noise.contact_m', 'water surface at a wet/dry boundary sigma',
@@ -222,7 +225,8 @@ class EkfSettings:
         'spread (soil_online) exceeds this: an unknown soil biases the surface (0: off, '
         'the configured soil trusted)', 0, 10)
     force_update_max_slip_spread: float = _f(
-        'force_update.max_slip_spread', "no force update where the ground speed's uncertainty "
+        'force_update.max_slip_spread', "no force update where the slip's uncertainty (the "
+        "ground speed's and the belt's reading's) "
         "moves the model's force by more than this share of it (a small slip on a soft "
         'soil: the force then tells the slip, not the water; 0: off)', 0, 10)
     contact_bracket_period_s: float = _f(

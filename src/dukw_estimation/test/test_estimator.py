@@ -550,6 +550,28 @@ def test_an_unlearnt_soil_widens_the_track_force_noise():
     assert fractions['trusted'] < truth + 0.05
 
 
+def test_the_belt_speeds_noise_widens_the_track_force_noise_at_small_slips():
+    """noise.track_speed_mps: the slip (v - u) / v is the belt's reading's as much as the
+    ground speed's, so at a small slip the encoder's noise widens each force update's noise
+    (the forces move the surface less, still some) and, beyond force_update.max_slip_spread,
+    keeps the update out; at a large slip it hardly matters."""
+    def fraction(slip_, **changes):
+        changes = {'force_update_max_slip_spread': 0.0, **changes}
+        est = make(wave_sigma_m=0.07, waterline_sigma_m=0.05, soil_scale_sigma=0.0,
+                   soil_online_enabled=False, **changes)
+        _surf_run(est, -0.06, slip_, seconds=1.0)
+        return est.traction().weight_on_tracks_fraction
+    deaf = fraction(0.05, force_update_sigma_n=0.0)
+    exact = fraction(0.05, track_speed_sigma_mps=0.0)
+    noisy = fraction(0.05, track_speed_sigma_mps=0.05)
+    assert deaf < noisy - 0.1
+    assert noisy < exact - 0.01
+    assert fraction(0.4, track_speed_sigma_mps=0.05) == pytest.approx(
+        fraction(0.4, track_speed_sigma_mps=0.0), abs=0.005)
+    gated = fraction(0.05, track_speed_sigma_mps=0.05, force_update_max_slip_spread=0.2)
+    assert gated == pytest.approx(deaf, abs=1e-9)
+
+
 def test_track_forces_wait_until_the_sites_soil_is_learnt():
     """With force_update.max_soil_spread set: meeting the sand in the surf (no dry sand
     yet), the soil is only the configured prior, whose error would read as water, so the
