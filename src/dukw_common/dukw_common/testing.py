@@ -75,6 +75,19 @@ class NodeProcess:
             self.stdout, self.stderr = self.proc.communicate()
         return self.proc.returncode
 
+    def finish(self, timeout_s: float = 30.0) -> int:
+        """Wait for a program that ends by itself, and return its exit code.
+
+        A program that overstays ``timeout_s`` is stopped like :meth:`stop`. Sending SIGINT
+        to one that is already tearing down would kill it by the signal (exit -2) once the
+        interpreter has given SIGINT back to its default action.
+        """
+        try:
+            self.stdout, self.stderr = self.proc.communicate(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            return self.stop()
+        return self.proc.returncode
+
     def __enter__(self) -> 'NodeProcess':
         return self
 
