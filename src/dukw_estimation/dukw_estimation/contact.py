@@ -313,13 +313,28 @@ class ContactModel:
                      track_mps: float, ground_mps: float) -> float:
         """Soil force on the vehicle from one track at these speeds, with the weight the
         surface leaves it and the filter's soil strength factor, N (heading from ``x``)."""
-        body = self.vehicle.body
+        patch = self._surface_patch(x, waterline_distance_m, surface_m)
+        return x[_SOIL] * traction.track_force_f(patch, track_mps, ground_mps)
+
+    def soil_force_slopes(self, x: np.ndarray, waterline_distance_m: float, surface_m: float,
+                          track_mps: float, ground_mps: float) -> tuple[float, float, float]:
+        """``soil_force_n`` (the same bits) and its analytic slopes in the belt's and the
+        ground's speeds: (force N, d force / d track speed N s/m, d force / d ground speed
+        N s/m), from ``traction.track_force_slopes_f``."""
+        patch = self._surface_patch(x, waterline_distance_m, surface_m)
+        force, per_track, per_ground = traction.track_force_slopes_f(patch, track_mps,
+                                                                     ground_mps)
+        factor = x[_SOIL]
+        return factor * force, factor * per_track, factor * per_ground
+
+    def _surface_patch(self, x: np.ndarray, waterline_distance_m: float,
+                       surface_m: float) -> traction.TrackPatch:
+        """One track's patch with the weight and the saturation this surface leaves it."""
         heading_cos = math.cos(x[_YAW] - self.settings.seaward_yaw_rad)
         volume = self.grounded_volume_m3(waterline_distance_m, surface_m, heading_cos)
-        weight = self._effective_weight_n(min(volume, body.displaced_volume_m3))
-        return x[_SOIL] * self.track_force_n(
-            track_mps, ground_mps, 0.5 * weight,
-            self.saturation(waterline_distance_m, surface_m, heading_cos))
+        weight = self._effective_weight_n(min(volume, self.vehicle.body.displaced_volume_m3))
+        return self._patch(0.5 * weight, self.saturation(waterline_distance_m, surface_m,
+                                                         heading_cos))
 
     def saturation(self, waterline_distance_m: float, surface_m: float,
                    heading_cos: float) -> float:

@@ -21,8 +21,6 @@ from dukw_common.readings import DepthReading, DriveStatus, WaterContact
 from dukw_estimation.settings import EkfSettings
 
 SECANT_STEPS_M = (0.005, 0.02, 0.05, 0.1, 0.2)   # surface steps of the force's derivative
-GROUND_STEP_MPS = 0.01                            # ground-speed step of the force's derivative
-BELT_STEP_MPS = 0.01                              # belt-speed step of the force's derivative
 SOIL_STEPS = (1e-3, 1e-3)                         # phi (rad), k (m) steps of the same
 
 
@@ -231,17 +229,15 @@ class SurfaceObserver:
             soil_spread = self._soil_relative_variance(track_mps, ground_mps)
             if soil_spread > st.force_update_max_soil_spread ** 2:
                 return                   # the site's soil is not known well enough yet
-        force = self.contact.soil_force_n
-        predicted = force(x, x[Idx.S], x[Idx.ETA], track_mps, ground_mps)
+        predicted, per_belt_mps, per_ground_mps = self.contact.soil_force_slopes(
+            x, x[Idx.S], x[Idx.ETA], track_mps, ground_mps)
         per_m = self._force_per_m(x, predicted, measured_n, track_mps, ground_mps)
         if per_m is None:
             return                       # the surface cannot explain the difference
-        per_mps = (force(x, x[Idx.S], x[Idx.ETA], track_mps, ground_mps + GROUND_STEP_MPS)
-                   - predicted) / GROUND_STEP_MPS
         ground_var = P[Idx.U, Idx.U] + lever * lever * P[Idx.R, Idx.R] \
             + 2.0 * lever * P[Idx.U, Idx.R]
-        slip_var = per_mps * per_mps * max(ground_var, 0.0) \
-            + self._belt_speed_variance_n2(x, track_mps, ground_mps, predicted)
+        slip_var = per_ground_mps * per_ground_mps * max(ground_var, 0.0) \
+            + self._belt_speed_variance_n2(track_mps, per_belt_mps)
         if st.force_update_max_slip_spread > 0.0 and math.sqrt(slip_var) \
                 > st.force_update_max_slip_spread * max(abs(predicted), abs(measured_n), 1.0):
             return                       # the force says more about the slip than the surface
@@ -257,20 +253,17 @@ class SurfaceObserver:
                           only=SURFACE_STATES if learn_soil else WATER_SURFACE_STATES)
         self.clip_soil_scale(ekf)
 
-    def _belt_speed_variance_n2(self, x: np.ndarray, track_mps: float, ground_mps: float,
-                                predicted_n: float) -> float:
+    def _belt_speed_variance_n2(self, track_mps: float, per_belt_mps: float) -> float:
         """The Wong force's variance from the belt speed's reading (``noise.track_speed_mps``,
-        the encoder's noise), N^2: the slip (v - u) / v is the belt's as much as the
-        ground's, and at the surf's small slips a 0.01 m/s error in either moves the force
-        by 10-30 % (issue 18, seed 2029's 142: belt read 0.674-0.701 m/s, the model's force
-        at the true ground speed 62-120 N against a measured 95-100 N). A held belt (read
-        as 0) slips -1 whatever its noise: none."""
+        the encoder's noise), N^2, through the force's slope in the belt speed
+        ``per_belt_mps`` (N s/m): the slip (v - u) / v is the belt's as much as the ground's,
+        and at the surf's small slips a 0.01 m/s error in either moves the force by 10-30 %
+        (issue 18, seed 2029's 142: belt read 0.674-0.701 m/s, the model's force at the
+        true ground speed 62-120 N against a measured 95-100 N). A held belt (read as 0)
+        slips -1 whatever its noise: none."""
         sigma = self.settings.track_speed_sigma_mps
         if sigma <= 0.0 or track_mps == 0.0:
             return 0.0
-        force = self.contact.soil_force_n
-        per_belt_mps = (force(x, x[Idx.S], x[Idx.ETA], track_mps + BELT_STEP_MPS, ground_mps)
-                        - predicted_n) / BELT_STEP_MPS
         return per_belt_mps * per_belt_mps * sigma * sigma
 
     def clip_soil_scale(self, ekf: MotionEkf) -> None:

@@ -572,6 +572,28 @@ def test_the_belt_speeds_noise_widens_the_track_force_noise_at_small_slips():
     assert gated == pytest.approx(deaf, abs=1e-9)
 
 
+@pytest.mark.parametrize('surface_m', [-0.3, -0.06, 0.1])
+def test_the_contact_models_force_slopes_are_its_forces_derivatives(surface_m):
+    """ContactModel.soil_force_slopes: the force of soil_force_n to the bit (weight,
+    saturation, the soil's factor) and its slopes in the belt's and the ground's speeds
+    those of central differences, in the surf (saturated, with pore suction) and ashore."""
+    est = make()
+    x = est.ekf.x.copy()
+    x[Idx.SOIL] = 1.3
+    contact, step = est.contact, 1e-6
+
+    def slope(track, ground, dt, dg):
+        return (contact.soil_force_n(x, 4.0, surface_m, track + dt, ground + dg)
+                - contact.soil_force_n(x, 4.0, surface_m, track - dt, ground - dg)) / (
+            2.0 * step)
+    for track, ground in ((0.7, 0.66), (0.7, 0.4), (-0.5, -0.45), (0.0, 0.2)):
+        force = contact.soil_force_slopes(x, 4.0, surface_m, track, ground)
+        assert force[0] == contact.soil_force_n(x, 4.0, surface_m, track, ground)
+        assert abs(force[0]) > 1.0
+        assert force[1] == pytest.approx(slope(track, ground, step, 0.0), rel=1e-4, abs=1e-3)
+        assert force[2] == pytest.approx(slope(track, ground, 0.0, step), rel=1e-4, abs=1e-3)
+
+
 def test_track_forces_wait_until_the_sites_soil_is_learnt():
     """With force_update.max_soil_spread set: meeting the sand in the surf (no dry sand
     yet), the soil is only the configured prior, whose error would read as water, so the
