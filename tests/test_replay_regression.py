@@ -97,11 +97,14 @@ def test_mode_manager_node_through_real_topics_makes_the_recorded_changes():
     recorded = _recorded_modes(bag)
     end_s = bag_io.summarize(bag).end_ns * 1e-9
     seen: list[tuple[float, str]] = []
+    last_stamp_s = [0.0]
 
     def on_mode(msg):
         name = MODE_NAMES[msg.mode]
+        stamp_s = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        last_stamp_s[0] = max(last_stamp_s[0], stamp_s)
         if name != 'SAFE_STOP' and (not seen or seen[-1][1] != name):
-            seen.append((msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9, name))
+            seen.append((stamp_s, name))
 
     with ros_node('mode_probe') as (node, executor):
         node.create_subscription(DriveMode, 'drive_mode', on_mode, STATE_QOS)
@@ -113,14 +116,19 @@ def test_mode_manager_node_through_real_topics_makes_the_recorded_changes():
             # (under use_sim_time the node decides nothing before the first /clock)
             assert spin_until(executor, lambda: node.count_publishers('drive_mode') > 0, 30)
             spin_until(executor, lambda: False, 0.5)
+            # at the bag's own rate: the node stamps inputs on arrival in /clock's time, so a
+            # busy machine's delivery delay counts rate x in the changes' times (at rate 2 a
+            # loaded CI machine put TRANSITION 0.7 s off)
             player = NodeProcess('dukw_bringup', 'play', [
-                str(bag), '--clock', '--rate', '2',
+                str(bag), '--clock', '--rate', '1',
                 '--topics', 'water/contact', 'depth', 'traction', 'tracks/status', 'imu/data',
                 '--wait-for', 'water/contact', 'depth', 'traction', 'tracks/status', 'imu/data',
                 'clock',
                 '--wait-timeout', '30'])
-            spin_until(executor, lambda: not player.alive() and seen
-                       and seen[-1][0] > end_s - 1.0, 90)
+            # until the node has decided up to the bag's last second (its decisions, not
+            # only its changes: the last change comes seconds before the end)
+            spin_until(executor, lambda: not player.alive()
+                       and last_stamp_s[0] > end_s - 1.0, 120)
             spin_until(executor, lambda: False, 0.5)
         finally:
             play_code = player.stop(timeout_s=30) if player else None
