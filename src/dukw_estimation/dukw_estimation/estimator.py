@@ -217,12 +217,15 @@ class Estimator:
         hull at a speed a still IMU cannot show (calm water, belts stopped); so may the waves
         over the sand when the tracks carry little weight (the held belts' grip is the
         weight's: campaign run 104 slid at 0.09 m/s for a second at a share of 0.22, the IMU
-        still), hence ``zupt.min_fraction``."""
+        still), hence ``zupt.min_fraction``. The stance detector takes the surge and sway
+        accelerations net of the filter's learnt accelerometer bias."""
         st, motion = self.settings, self.motion_filter
         self.at_rest = False
         if not st.zupt_enabled:
             return
-        still = self.stance.add(s, motion.gravity_free_accel())
+        surge, sway = motion.gravity_free_accel()
+        x = self.ekf.x
+        still = self.stance.add(s, (surge - x[Idx.ACCEL_BIAS_X], sway - x[Idx.ACCEL_BIAS_Y]))
         tracks = motion.tracks
         if not still or self.contact.afloat or self.contact.fraction < st.zupt_min_fraction \
                 or tracks is None \

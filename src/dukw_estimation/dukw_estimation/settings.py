@@ -185,8 +185,8 @@ class EkfSettings:
                                       '(the angular rates: noise.gyro_rps)', 1e-5, 10)
     zupt_mean_accel_mps2: float = _f('zupt.mean_accel_mps2', "and while the window's mean "
                                      'surge and sway acceleration (gravity removed with the '
-                                     "IMU's attitude) is under this (a steady push varies "
-                                     'nothing)', 1e-4, 10)
+                                     "IMU's attitude, the learnt accelerometer bias too) is "
+                                     'under this (a steady push varies nothing)', 1e-4, 10)
     zupt_min_fraction: float = _f('zupt.min_fraction', 'and while the tracks carry at least '
                                   'this share of the weight (less: the waves push the hull '
                                   'over the sand steadily, which a still IMU does not show)',

@@ -14,14 +14,15 @@ count as motion, does not stop it from firing.
 
 A steady acceleration varies nothing within a window, and Skog's detectors do not see it
 either (it tilts the specific force, |f| = sqrt(g^2 + a^2) changes by a^2 / 2g): a wave
-sliding the vehicle at 0.25 Hz, 0.24 m/s^2, changes its acceleration by 0.005 m/s^2 RMS
-over half a second at its peak while the speed changes by 0.12 m/s. So the window's mean
-surge and sway acceleration, gravity removed with the IMU's attitude, must be small too
-(``mean_accel_mps2``, the attitude error's gravity leak): between the peaks, where the
-mean is small, the acceleration changes fast. Likewise a hull rolling or pitching at a
-rate's peak: the window's mean roll and pitch rate must be small too (``mean_rate_rps``; not
-the yaw rate, whose gyro bias the filter learns: a vehicle on the sand cannot turn on the
-spot with its belts stopped without the acceleration showing).
+sliding the vehicle at 0.25 Hz, 0.24 m/s^2, changes its acceleration by 0.005 m/s^2 RMS over
+half a second at its peak while the speed changes by 0.12 m/s. So the window's mean surge
+and sway acceleration, gravity removed with the IMU's attitude, must be small too
+(``mean_accel_mps2``; the caller gives the accelerations net of its learnt accelerometer
+bias, the attitude error's gravity leak, so the bound is that bias's spread, not its size):
+between the peaks, where the mean is small, the acceleration changes fast. Likewise a hull
+rolling or pitching at a rate's peak: the window's mean roll and pitch rate must be small
+too (``mean_rate_rps``; not the yaw rate, whose gyro bias the filter learns: a vehicle on
+the sand cannot turn on the spot with its belts stopped without the acceleration showing).
 
 Blind spot left: a steady drift; a vehicle carried by calm water decelerates by its drag,
 0.006 m/s^2 at 0.1 m/s, under the IMU's noise. The caller must rule that out otherwise (the
