@@ -354,7 +354,7 @@ class ContactModel:
     def _patch(self, weight_n: float, saturation: float) -> traction.TrackPatch:
         """One track's patch at this weight and saturation on the present soil
         (``traction.track_force_f``: the same bits as ``track_force_n``), remembered while
-        they hold: both tracks and the force's probes ask for the same one."""
+        they hold: both tracks' forces and slopes at one surface ask for the same one."""
         key = (weight_n, saturation, self.soil)
         if self._patch_key != key:
             self._patch_key = key
