@@ -42,6 +42,7 @@ _NO_PAIR = (math.nan, math.nan)
 # plain ints for the hot paths (indexing numpy with IntEnum members is slower)
 _YAW, _S, _ETA, _SOIL = int(Idx.YAW), int(Idx.S), int(Idx.ETA), int(Idx.SOIL)
 _HEAVE_RATE = int(Idx.HEAVE_RATE)
+_ACCEL_BIAS_X, _ACCEL_BIAS_Y = int(Idx.ACCEL_BIAS_X), int(Idx.ACCEL_BIAS_Y)
 
 
 class Estimator:
@@ -225,7 +226,7 @@ class Estimator:
             return
         surge, sway = motion.gravity_free_accel()
         x = self.ekf.x
-        still = self.stance.add(s, (surge - x[Idx.ACCEL_BIAS_X], sway - x[Idx.ACCEL_BIAS_Y]))
+        still = self.stance.add(s, (surge - x[_ACCEL_BIAS_X], sway - x[_ACCEL_BIAS_Y]))
         tracks = motion.tracks
         if not still or self.contact.afloat or self.contact.fraction < st.zupt_min_fraction \
                 or tracks is None \
