@@ -113,6 +113,7 @@ class MotionFilter:
         self._gravity_free_mps2 = (math.nan, math.nan)
         self.tracks: DriveStatus | None = None
         self.props: DriveStatus | None = None
+        self.track_odometry_t_s = -math.inf     # the last held-slip speed update
 
     def fresh(self, sensor: str, t_s: float) -> bool:
         """The sensor spoke within ``sensor_timeout_s`` before ``t_s``."""
@@ -331,14 +332,18 @@ class MotionFilter:
         dry beach, 1 for a vehicle stuck in the surf, so the belt speed alone overstates
         the ground speed by slip x belt speed (issue 18: a stuck vehicle read as moving at
         its belt speed through a GPS dropout). The soil and the load last over a dropout
-        of seconds; the waves' change of the slip is in ``noise.track_odometry_mps``.
+        of seconds; the waves' change of the slip is in ``noise.track_odometry_mps``. The
+        held slips' error is one for the whole dropout (the slip's change since), so the
+        tracks speak at most every ``noise.track_odometry_period_s``, not at each status.
         Nothing without a held slip, or with a belt too slow for the slip to say the
         ground speed (``TRACK_ODOMETRY_MIN_BELT_MPS``)."""
         st = self.settings
         speeds = (s.port.speed_mps, s.stbd.speed_mps)
         if slips is None or not all(math.isfinite(i) for i in slips) \
-                or min(abs(v) for v in speeds) < TRACK_ODOMETRY_MIN_BELT_MPS:
+                or min(abs(v) for v in speeds) < TRACK_ODOMETRY_MIN_BELT_MPS \
+                or s.t_s - self.track_odometry_t_s < st.track_odometry_period_s:
             return
+        self.track_odometry_t_s = s.t_s
         port, stbd = (v * (1.0 - i) for v, i in zip(speeds, slips, strict=True))
         H = np.zeros((2, N_STATES))
         H[0, Idx.U] = H[1, Idx.R] = 1.0

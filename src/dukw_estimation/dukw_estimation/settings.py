@@ -72,6 +72,9 @@ class EkfSettings:
     depth_m: float = _f('noise.depth_m', 'depth sounder sigma (incl. heave)', 1e-4, 5)
     track_odometry_mps: float = _f('noise.track_odometry_mps',
                                    'track-speed pseudo-measurement sigma (GPS stale)', 1e-3, 10)
+    track_odometry_period_s: float = _f(
+        'noise.track_odometry_period_s', 'at most this often (the held slips are one error '
+        'for the dropout, not a new one at each status), s', 0, 60)
     # process noise
     q_position_m: float = _f('process.position_m', 'position random walk', 0, 10)
     q_yaw_rad: float = _f('process.yaw_rad', 'heading random walk', 0, 10)
