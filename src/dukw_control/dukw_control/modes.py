@@ -357,7 +357,9 @@ class ModeManager:
 
     def _afloat_evidence(self, depth_ok: bool, started: bool, share_limit: float) -> bool:
         """Afloat: little weight on the tracks, their force at drivetrain friction, water
-        under the sounder or over both sensors, and (``water_needs_estimated_afloat``) the
+        under the sounder or over a sensor (a floating hull pitching on a wave lifts one out
+        for a moment; both dry with no depth is the ground's evidence, ``water_exit_dry_s``),
+        and (``water_needs_estimated_afloat``) the
         estimator's own contact decision afloat when the count starts (``started``: it
         has, and the rest still holds). The weight share is read from the estimated surface,
         which lags a receding wave by up to a second; the contact decision comes from the IMU
@@ -370,7 +372,7 @@ class ModeManager:
         s = self.s
         return (self.weight_fraction < share_limit
                 and self.track_force_n <= s.friction_force_n
-                and (depth_ok or (self.fore_wet and self.aft_wet))
+                and (depth_ok or self.fore_wet or self.aft_wet)
                 and (self.estimated_afloat or started or not s.water_needs_estimated_afloat))
 
     def _wet_text(self) -> str:

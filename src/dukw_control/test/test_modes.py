@@ -308,6 +308,21 @@ def test_to_sea_a_light_touchdown_after_the_first_float_keeps_the_water_count(mo
     assert f.modes[-1][1] - floated_s <= s.enter_water_s + 0.3 + 2 * DT
 
 
+def test_to_sea_one_wet_sensor_is_water_enough_for_the_count(mode_settings):
+    # issue 18 (seed 2029 run 79): the hull's first float lasted 0.7 s, its bow pitched up
+    # on the wave and the fore sensor read dry for 0.3 s of it while the aft one, the share
+    # and the estimator's contact decision said afloat; the count waited for both wet and
+    # WATER came with the next float, 3.9 s after the truth's. Afloat one sensor is water
+    # enough (WATER keeps it, test above); both dry with no depth is the ground's evidence.
+    s = mode_settings
+    f = _to_sea_transition(s)
+    f.run(s.enter_water_s + 0.6, fraction=0.0, aft=True, force_n=10.0)   # force low-passed
+    assert f.mm.mode == Mode.WATER
+    f = _to_sea_transition(s)
+    f.run(s.enter_water_s + 0.6, fraction=0.0, force_n=10.0)    # no water reading at all
+    assert f.mm.mode == Mode.TRANSITION
+
+
 def test_to_sea_a_grounding_past_water_exit_fraction_restarts_the_water_count(mode_settings):
     s = mode_settings
     f = _to_sea_transition(s)
