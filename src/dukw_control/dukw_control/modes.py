@@ -356,19 +356,19 @@ class ModeManager:
         return Mode.LAND, f'on land (weight on tracks {f:.2f}, sensors dry)'
 
     def _afloat_evidence(self, depth_ok: bool, started: bool, share_limit: float) -> bool:
-        """Afloat: little weight on the tracks, their force at drivetrain friction, water
-        under the sounder or over a sensor (a floating hull pitching on a wave lifts one out
-        for a moment; both dry with no depth is the ground's evidence, ``water_exit_dry_s``),
-        and (``water_needs_estimated_afloat``) the
-        estimator's own contact decision afloat when the count starts (``started``: it
-        has, and the rest still holds). The weight share is read from the estimated surface,
-        which lags a receding wave by up to a second; the contact decision comes from the IMU
-        (a floating hull rolls, pitches and heaves with the waves, one on the sand lies still)
-        or from water deep enough to float it beyond doubt, and so tells a hull the receding
-        water has set down on the sand from one it still carries. It starts the count but
-        need not hold it: in a long, low sea a floating hull's motion comes and goes about
-        the motion test's threshold with each wave. ``share_limit``: the share under which
-        it holds (water_enter_fraction, or while counting ``_water_count_share``)."""
+        """Afloat: little weight on the tracks, their force at drivetrain friction, water under
+        the sounder or over a sensor (a floating hull pitching on a wave lifts one out for a
+        moment; both dry with no depth is the ground's evidence, ``water_exit_dry_s``), and
+        (``water_needs_estimated_afloat``) the estimator's own contact decision afloat when
+        the count starts (``started``: it has, and the rest still holds). The weight share
+        is read from the estimated surface, which lags a receding wave by up to a second;
+        the contact decision comes from the IMU (a floating hull rolls, pitches and heaves
+        with the waves, one on the sand lies still) or from water deep enough to float it
+        beyond doubt, and so tells a hull the receding water has set down on the sand from
+        one it still carries. It starts the count but need not hold it: in a long, low sea a
+        floating hull's motion comes and goes about the motion test's threshold with each
+        wave. ``share_limit``: the share under which it holds (water_enter_fraction, or
+        while counting ``_water_count_share``)."""
         s = self.s
         return (self.weight_fraction < share_limit
                 and self.track_force_n <= s.friction_force_n
