@@ -76,6 +76,7 @@ class Spec:
     sim_overrides: Mapping[str, Any]
     oracle_site: bool = False
     mission: MissionSpec | None = None     # the mission kind's mission (loaded, cut)
+    oracle_surface: bool = False           # diagnostic: the water over grounded hulls known
 
 
 def load_spec(path: str) -> Spec:
@@ -95,7 +96,7 @@ def parse_spec(raw: Any) -> Spec:
     if not isinstance(raw, dict):
         raise SpecError('campaign spec must be a mapping')
     known = {'name', 'seed', 'runs', 'duration_s', 'warm_up_s', 'kinds', 'draws', 'faults',
-             'targets', 'sim_overrides', 'oracle_site', 'mission'}
+             'targets', 'sim_overrides', 'oracle_site', 'oracle_surface', 'mission'}
     _no_unknown(raw, known, 'spec')
     seed = _int(raw, 'seed', 0, 2 ** 63 - 1)
     runs = _int(raw, 'runs', 1, 10_000_000)
@@ -123,13 +124,18 @@ def parse_spec(raw: Any) -> Spec:
         raise SpecError('sim_overrides must be a mapping of dotted sim_node parameters')
     for key, value in overrides.items():
         _distribution(value, f'sim_overrides.{key}', None)
-    oracle = raw.get('oracle_site', False)
-    if not isinstance(oracle, bool):
-        raise SpecError(f'oracle_site must be true or false, got {oracle!r}')
+    oracle, oracle_surface = (_flag(raw, name) for name in ('oracle_site', 'oracle_surface'))
     mission = _mission(raw.get('mission', {}), 'mission' in kinds)
     return Spec(str(raw.get('name', 'campaign')), seed, runs, duration, warm_up, tuple(kinds),
                 checked, faults, {k: float(targets[k]) for k in TARGET_NAMES}, dict(overrides),
-                oracle, mission)
+                oracle, mission, oracle_surface)
+
+
+def _flag(raw: Mapping[str, Any], name: str) -> bool:
+    value = raw.get(name, False)
+    if not isinstance(value, bool):
+        raise SpecError(f'{name} must be true or false, got {value!r}')
+    return value
 
 
 def _mission(raw: Any, needed: bool) -> MissionSpec | None:
@@ -332,6 +338,21 @@ SERIES_COLUMNS = ('t_s', 'x_m', 'y_m', 'yaw_rad', 'est_x_m', 'est_y_m', 'est_yaw
                   'port_prop_pct', 'stbd_prop_pct', 'port_track_mps', 'stbd_track_mps')
 
 
+def _surface_oracle(loop) -> Callable[[str, int, Any], None]:
+    """A listener that, at each sensor reading while the truth's hulls touch the sand, pins
+    the estimator's surface to the truth's: the water depth at base_link (the waterline
+    distance on the estimator's own slope that gives it) and the wave there."""
+    from dukw_bringup.stack_harness import SENSOR_TOPICS
+    from dukw_sim.truth import Medium
+
+    def pin(topic: str, t_ns: int, item: Any) -> None:
+        truth, est = loop.truth, loop.est
+        if topic in SENSOR_TOPICS and truth.medium != Medium.WATER:
+            depth_m = truth.waterline_distance_m * math.sin(truth.slope_rad)
+            est.pin_surface(depth_m / math.sin(est.contact.slope_rad), truth.wave_elevation_m)
+    return pin
+
+
 def build_loop(spec: Spec, cond: Mapping[str, Any]):
     """The in-process stack for these conditions, placed at its start."""
     from dukw_bringup.stack_harness import ClosedLoop
@@ -339,6 +360,8 @@ def build_loop(spec: Spec, cond: Mapping[str, Any]):
                       estimator_knows_site=spec.oracle_site, sensor_filter=SensorFaults(cond))
     if spec.oracle_site:                 # diagnostic: the estimator knows the drawn soil too
         loop.est.set_soil(loop.sim.vehicle.soil)
+    if spec.oracle_surface:
+        loop.listeners.append(_surface_oracle(loop))
     loop.sensors.seed = cond['sensor_seed']
     loop.sensors.reset()
     if cond['kind'] == 'mission':
