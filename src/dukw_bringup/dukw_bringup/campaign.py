@@ -341,7 +341,11 @@ SERIES_COLUMNS = ('t_s', 'x_m', 'y_m', 'yaw_rad', 'est_x_m', 'est_y_m', 'est_yaw
 def _surface_oracle(loop) -> Callable[[str, int, Any], None]:
     """A listener that, at each sensor reading while the truth's hulls touch the sand, pins
     the estimator's surface to the truth's: the water depth at base_link (the waterline
-    distance on the estimator's own slope that gives it) and the wave there."""
+    distance on the estimator's own slope that gives it) and the wave there. Not
+    ``evaluate --oracle-surface``'s pin of the true waterline distance itself: here the
+    estimator keeps its configured slope, so the same distance would put another depth under
+    the hulls; and only grounded, since afloat over the flat sea floor the truth's slope is
+    0 and the depth says nothing of the distance."""
     from dukw_bringup.stack_harness import SENSOR_TOPICS
     from dukw_sim.truth import Medium
 
