@@ -28,6 +28,13 @@ TIMEOUT_S = 0.5                   # cmd_timeout_s, imu_timeout_s, traction_timeo
 SLACK_S = 0.15                    # one probe period, a controller step and delivery
 
 
+def moving_before_neutral(tracks: list, since: float) -> int:
+    """How many moving tracks/cmd the probe received after ``since`` before the first
+    neutral one."""
+    after = [m for t, m in tracks if t > since]
+    return next(i for i, m in enumerate(after) if m.stbd_pct == 0.0)
+
+
 class Rig:
     """Feeds every input the two nodes need; records tracks/cmd, drive_mode, diagnostics."""
 
@@ -176,8 +183,11 @@ def test_rc_takeover_is_neutral_at_once(rig):
     since = time.monotonic()
     rig.authority(Authority.HOLDER_RC)
     reaction = rig.reaction_s(since)
-    print(f'RC takeover -> neutral tracks: {reaction:.3f} s')
-    assert reaction <= 0.1
+    late = moving_before_neutral(rig.tracks, since)
+    print(f'RC takeover -> neutral tracks: {reaction:.3f} s, {late} moving command(s) between')
+    # at once: on the authority itself, not a timer later; counted in commands, not in wall
+    # seconds a busy machine stretches (one in flight, one tick due at the same wake-up)
+    assert late <= 2
     rig.authority(Authority.HOLDER_COMPUTER)
 
 

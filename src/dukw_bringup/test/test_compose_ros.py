@@ -110,7 +110,10 @@ def test_composed_chain_drives_publishes_the_contract_and_stops_at_once_on_takeo
                               lambda: sensors.tracks()[-1][1].stbd_pct == 0.0, 5.0)
             after = [(t, m) for t, m in sensors.tracks() if t > sent]
             first_neutral = next(t for t, m in after if m.stbd_pct == 0.0)
-            assert first_neutral - sent < 0.25, first_neutral - sent   # slack: shared CPUs
+            # within one step: counted in commands, not in wall seconds a busy machine
+            # stretches (one in flight, one tick due at the same wake-up)
+            late = [m.stbd_pct == 0.0 for _, m in after].index(True)
+            assert late <= 2, f'{late} moving commands in {first_neutral - sent:.3f} s'
             moving_after = [t for t, m in after if m.stbd_pct != 0.0 and t > first_neutral]
             assert not moving_after
         assert proc.proc.returncode == 0, proc.stderr
