@@ -19,20 +19,13 @@ from sensor_msgs.msg import Imu
 
 from dukw_common.cmd_vel import make_cmd_vel
 from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS
-from dukw_common.testing import NodeProcess, ros_node, spin_until
+from dukw_common.testing import NodeProcess, moving_before_neutral, ros_node, spin_until
 
 pytestmark = pytest.mark.ros
 
 PERIOD_S = 0.02                   # the probe's sensors and cmd_vel at 50 Hz
 TIMEOUT_S = 0.5                   # cmd_timeout_s, imu_timeout_s, traction_timeout_s (config)
 SLACK_S = 0.15                    # one probe period, a controller step and delivery
-
-
-def moving_before_neutral(tracks: list, since: float) -> int:
-    """How many moving tracks/cmd the probe received after ``since`` before the first
-    neutral one."""
-    after = [m for t, m in tracks if t > since]
-    return next(i for i, m in enumerate(after) if m.stbd_pct == 0.0)
 
 
 class Rig:

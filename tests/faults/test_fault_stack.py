@@ -21,18 +21,13 @@ import pytest
 from dukw_msgs.msg import Authority, DiffCommand
 from nav_msgs.msg import Odometry
 
-from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS
+from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS, stamp_to_s
 from dukw_common.testing import executable, ros_node, spin_until
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 TIMEOUT_S = 0.5                  # imu_timeout_s / traction_timeout_s (config)
 SLACK_S = 0.15                   # the controller's tick and the delivery, sim seconds
-
-
-def stamp_s(msg) -> float:
-    """The message's header stamp (the publishing node's clock, sim time here), s."""
-    return msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
 
 
 def recorder(node, msg_type, topic: str, qos) -> list:
@@ -85,7 +80,8 @@ def test_killed_ekf_ends_in_neutral_and_stops_the_stack(tmp_path):
             assert spin_until(executor, neutral_after, 10.0)
             wall_t, neutral = neutral_after()[0]
         assert estimates, 'no estimate came before the kill'
-        reaction = stamp_s(neutral) - max(stamp_s(m) for _, m in estimates)
+        last_s = max(stamp_to_s(m.header.stamp) for _, m in estimates)
+        reaction = stamp_to_s(neutral.header.stamp) - last_s
         print(f'EKF killed -> neutral tracks: {reaction:.3f} sim s after its last estimate '
               f'({wall_t - since:.3f} wall s after the kill)')
         assert 0.0 < reaction <= TIMEOUT_S + SLACK_S
@@ -113,7 +109,8 @@ def test_killed_composed_chain_ends_in_switch_neutral_and_stops_the_stack(tmp_pa
                         and m.reason == Authority.REASON_COMMAND_TIMEOUT]
             assert spin_until(executor, timed_out, 10.0)
             wall_t, neutral = timed_out()[0]
-        reaction = stamp_s(neutral) - max(stamp_s(m) for _, m in tracks)
+        last_s = max(stamp_to_s(m.header.stamp) for _, m in tracks)
+        reaction = stamp_to_s(neutral.header.stamp) - last_s
         print(f'composed chain killed -> switch neutral: {reaction:.3f} sim s after its last '
               f'command ({wall_t - since:.3f} wall s after the kill)')
         assert 0.0 < reaction <= TIMEOUT_S + SLACK_S + 0.1   # + the switch's status period

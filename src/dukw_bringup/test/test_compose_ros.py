@@ -15,7 +15,8 @@ from tf2_msgs.msg import TFMessage
 from dukw_common.cmd_vel import cmd_vel_type, make_cmd_vel
 from dukw_common.node_tools import COMMAND_QOS, SENSOR_QOS, STATE_QOS
 from dukw_common.tf_tools import TF_QOS
-from dukw_common.testing import NodeProcess, executable, ros_node, spin_until
+from dukw_common.testing import (NodeProcess, executable, moving_before_neutral,
+                                  ros_node, spin_until)
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(120)]
 
@@ -110,9 +111,8 @@ def test_composed_chain_drives_publishes_the_contract_and_stops_at_once_on_takeo
                               lambda: sensors.tracks()[-1][1].stbd_pct == 0.0, 5.0)
             after = [(t, m) for t, m in sensors.tracks() if t > sent]
             first_neutral = next(t for t, m in after if m.stbd_pct == 0.0)
-            # within one step: counted in commands, not in wall seconds a busy machine
-            # stretches (one in flight, one tick due at the same wake-up)
-            late = [m.stbd_pct == 0.0 for _, m in after].index(True)
+            # within one step: one command in flight, one tick due at the same wake-up
+            late = moving_before_neutral(sensors.tracks(), sent)
             assert late <= 2, f'{late} moving commands in {first_neutral - sent:.3f} s'
             moving_after = [t for t, m in after if m.stbd_pct != 0.0 and t > first_neutral]
             assert not moving_after

@@ -48,6 +48,14 @@ def spin_until(executor: SingleThreadedExecutor, predicate: Callable[[], bool],
     return predicate()
 
 
+def moving_before_neutral(commands: Sequence[tuple[float, object]], since: float) -> int:
+    """How many moving commands (``stbd_pct`` not 0) of the (receive time, DiffCommand)
+    list came after ``since`` before the first neutral one: "at once" counted in commands,
+    which a busy machine does not stretch as it stretches wall seconds."""
+    after = [m for t, m in commands if t > since]
+    return next(i for i, m in enumerate(after) if m.stbd_pct == 0.0)
+
+
 class NodeProcess:
     """An installed node run as its own process, stopped with SIGINT like Ctrl-C."""
 
